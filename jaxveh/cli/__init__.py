@@ -1,0 +1,3 @@
+"""The ``jaxveh`` command line."""
+
+from ._main import app as app, main as main

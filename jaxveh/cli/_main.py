@@ -1,0 +1,16 @@
+"""Top-level ``jaxveh`` Typer application; each sub-command group lives in its own module."""
+
+import typer
+
+app = typer.Typer(
+    help="jaxveh: differentiable vehicle dynamics with a flexible chassis.",
+    no_args_is_help=True,
+    add_completion=False,
+)
+
+# Sub-command groups are registered below, one line each.
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()

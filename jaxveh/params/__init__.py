@@ -1,0 +1,28 @@
+"""Vehicle parameters: Equinox pytrees in SI units, loaded from TOML data files."""
+
+from ._appendix_a import (
+    AnalyticVehicle as AnalyticVehicle,
+    AxleTyre as AxleTyre,
+    analytic_vehicle_from_dict as analytic_vehicle_from_dict,
+    load_analytic_vehicle as load_analytic_vehicle,
+)
+from ._appendix_b import (
+    CORNERS as CORNERS,
+    HARD_POINT_NAMES as HARD_POINT_NAMES,
+    SPRUNG_HARD_POINTS as SPRUNG_HARD_POINTS,
+    CornerHardPoints as CornerHardPoints,
+    RigidBodyData as RigidBodyData,
+    TyreData as TyreData,
+    UnsprungData as UnsprungData,
+    VehicleData as VehicleData,
+    hard_points_vehicle_frame as hard_points_vehicle_frame,
+    load_vehicle_data as load_vehicle_data,
+    vehicle_data_from_dict as vehicle_data_from_dict,
+)
+from ._fields import as_float as as_float, float_field as float_field
+from ._schema import (
+    UNIT_TO_SI as UNIT_TO_SI,
+    ParameterError as ParameterError,
+    Quantity as Quantity,
+    read_section as read_section,
+)

@@ -1,0 +1,197 @@
+"""Appendix B data set (chapters 6-7): the 14-DOF vehicle's general, mass and hard-point data."""
+
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+import equinox as eqx
+import jax.numpy as jnp
+from jaxtyping import Array, Float
+
+from ._fields import float_field
+from ._schema import ParameterError, Quantity, check_sections, read_section
+
+HARD_POINT_NAMES = ("A", "B", "C", "D", "E", "F", "H", "L", "M", "P", "Q", "R", "S", "T")
+#: Hard points on the sprung mass (chassis side) of each corner (section 6.2.2).
+SPRUNG_HARD_POINTS = ("A", "B", "E", "F", "L", "P", "Q", "T")
+CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
+
+_TB1 = "Table B.1"
+GENERAL = (
+    Quantity("a", "mm", "distance of vehicle c.g. from front axle", _TB1),
+    Quantity("b", "mm", "distance of vehicle c.g. from rear axle", _TB1),
+    Quantity("h_cg", "mm", "vehicle c.g. height", _TB1),
+    Quantity("track_front", "mm", "front track width", _TB1),
+    Quantity("track_rear", "mm", "rear track width", _TB1),
+    Quantity("toe_front", "deg", "static front toe angle", _TB1, lower=-10.0, upper=10.0, lower_open=False),
+    Quantity("toe_rear", "deg", "static rear toe angle", _TB1, lower=-10.0, upper=10.0, lower_open=False),
+    Quantity("camber_front", "deg", "static front camber angle", _TB1, lower=-10.0, upper=10.0, lower_open=False),
+    Quantity("camber_rear", "deg", "static rear camber angle", _TB1, lower=-10.0, upper=10.0, lower_open=False),
+)
+SPRUNG = (
+    Quantity("m", "kg", "sprung mass", _TB1),
+    Quantity("Jxx", "kg m2", "sprung mass roll inertia", _TB1),
+    Quantity("Jyy", "kg m2", "sprung mass pitch inertia", _TB1),
+    Quantity("Jzz", "kg m2", "sprung mass yaw inertia", _TB1),
+    Quantity("Jxz", "kg m2", "sprung mass x-z product of inertia", _TB1, lower=None),
+)
+UNSPRUNG = (
+    Quantity("m", "kg", "unsprung mass of one corner", _TB1),
+    Quantity("Jxx", "kg m2", "unsprung cambering inertia", _TB1),
+    Quantity("Jyy", "kg m2", "unsprung pitching inertia (rotating parts removed)", _TB1),
+    Quantity("Jzz", "kg m2", "unsprung yawing inertia", _TB1),
+    Quantity("J_wheel", "kg m2", "wheel spin inertia", _TB1),
+)
+TYRE = (
+    Quantity("kz", "N/m", "tyre vertical stiffness", "Table B.4"),
+    Quantity("cz", "Ns/m", "tyre vertical damping", "Table B.4", lower_open=False),
+    Quantity("sigma_kappa", "m", "longitudinal slip relaxation length", "Table B.4"),
+    Quantity("sigma_alpha", "m", "side slip relaxation length", "Table B.4"),
+)
+SECTIONS = ("general", "sprung", "unsprung_front", "unsprung_rear", "tyre", "hard_points_front", "hard_points_rear")
+
+
+class RigidBodyData(eqx.Module):
+    """Mass (kg) and inertia tensor (kg m^2, body axes x forward, y left, z up) of a body."""
+
+    mass: Float[Array, ""] = float_field()
+    inertia: Float[Array, "3 3"] = float_field()
+
+
+class UnsprungData(eqx.Module):
+    """One corner's unsprung mass (upright + wheel) and the wheel's spin inertia."""
+
+    body: RigidBodyData
+    wheel_spin_inertia: Float[Array, ""] = float_field()
+
+
+class CornerHardPoints(eqx.Module):
+    """The 14 hard points of a left corner (m), in the corner's local frame.
+
+    Local frame: origin on the ground, in the vehicle centre plane, below the axle centre;
+    x forward, y left, z up (Tables B.2, B.3; see docs/assumptions.md).
+    """
+
+    points: Float[Array, "14 3"] = float_field()
+
+    def __getitem__(self, name: str) -> Float[Array, "3"]:
+        return self.points[HARD_POINT_NAMES.index(name)]
+
+
+class TyreData(eqx.Module):
+    """Table B.4: vertical stiffness (N/m), damping (Ns/m), relaxation lengths (m)."""
+
+    kz: Float[Array, ""] = float_field()
+    cz: Float[Array, ""] = float_field()
+    sigma_kappa: Float[Array, ""] = float_field()
+    sigma_alpha: Float[Array, ""] = float_field()
+
+
+class VehicleData(eqx.Module):
+    """Appendix B data set in SI units (m, kg, rad)."""
+
+    a: Float[Array, ""] = float_field()
+    b: Float[Array, ""] = float_field()
+    h_cg: Float[Array, ""] = float_field()
+    track_front: Float[Array, ""] = float_field()
+    track_rear: Float[Array, ""] = float_field()
+    toe_front: Float[Array, ""] = float_field()
+    toe_rear: Float[Array, ""] = float_field()
+    camber_front: Float[Array, ""] = float_field()
+    camber_rear: Float[Array, ""] = float_field()
+    sprung: RigidBodyData
+    unsprung_front: UnsprungData
+    unsprung_rear: UnsprungData
+    tyre: TyreData
+    hard_points_front: CornerHardPoints
+    hard_points_rear: CornerHardPoints
+
+    @property
+    def wheelbase(self) -> Float[Array, ""]:
+        return self.a + self.b
+
+
+def _read_points(table, section: str, where: str) -> jnp.ndarray:
+    if section not in table:
+        raise ParameterError(f"{where}: missing section [{section}]")
+    data = table[section]
+    unknown = sorted(set(data) - set(HARD_POINT_NAMES))
+    if unknown:
+        raise ParameterError(f"{where} [{section}]: unknown hard point(s) {unknown}; allowed {list(HARD_POINT_NAMES)}")
+    rows = []
+    for name in HARD_POINT_NAMES:
+        if name not in data:
+            raise ParameterError(f"{where} [{section}]: missing hard point {name}")
+        xyz = data[name]
+        ok = isinstance(xyz, list) and len(xyz) == 3 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in xyz
+        )
+        if not ok:
+            raise ParameterError(f"{where} [{section}].{name} must be a list of 3 numbers [x, y, z] in mm, got {xyz!r}")
+        if xyz[1] <= 0.0:
+            raise ParameterError(
+                f"{where} [{section}].{name}: y = {xyz[1]:g} mm must be > 0 (left corner, y points left)"
+            )
+        rows.append([float(v) * 1e-3 for v in xyz])
+    return jnp.asarray(rows)
+
+
+def _inertia(d) -> jnp.ndarray:
+    jxz = d.get("Jxz", 0.0)
+    return jnp.asarray([[d["Jxx"], 0.0, -jxz], [0.0, d["Jyy"], 0.0], [-jxz, 0.0, d["Jzz"]]])
+
+
+def vehicle_data_from_dict(table: dict, where: str = "<dict>") -> VehicleData:
+    """Build :class:`VehicleData` from a parsed TOML table, validating every field."""
+    check_sections(table, SECTIONS, where)
+    g = read_section(table, "general", GENERAL, where)
+    s = read_section(table, "sprung", SPRUNG, where)
+    uf = read_section(table, "unsprung_front", UNSPRUNG, where)
+    ur = read_section(table, "unsprung_rear", UNSPRUNG, where)
+    t = read_section(table, "tyre", TYRE, where)
+    # Product of inertia: J = [[Jxx, 0, -Jxz], ...] must stay positive definite.
+    if s["Jxz"] ** 2 >= s["Jxx"] * s["Jzz"]:
+        raise ParameterError(f"{where} [sprung].Jxz: |Jxz| must be < sqrt(Jxx*Jzz) for a positive-definite inertia")
+    return VehicleData(
+        **{k: v for k, v in g.items()},
+        sprung=RigidBodyData(s["m"], _inertia(s)),
+        unsprung_front=UnsprungData(RigidBodyData(uf["m"], _inertia(uf)), uf["J_wheel"]),
+        unsprung_rear=UnsprungData(RigidBodyData(ur["m"], _inertia(ur)), ur["J_wheel"]),
+        tyre=TyreData(**t),
+        hard_points_front=CornerHardPoints(_read_points(table, "hard_points_front", where)),
+        hard_points_rear=CornerHardPoints(_read_points(table, "hard_points_rear", where)),
+    )
+
+
+def load_vehicle_data(path: str | Path | None = None) -> VehicleData:
+    """Load an Appendix-B-style vehicle file (default: the shipped ``appendix_b.toml``)."""
+    if path is None:
+        text = resources.files("jaxveh.params").joinpath("data/appendix_b.toml").read_text()
+        where = "appendix_b.toml"
+    else:
+        path = Path(path)
+        if not path.is_file():
+            raise ParameterError(f"vehicle file {str(path)!r} does not exist")
+        text, where = path.read_text(), str(path)
+    try:
+        table = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ParameterError(f"{where}: not valid TOML ({e})") from None
+    return vehicle_data_from_dict(table, where)
+
+
+def hard_points_vehicle_frame(data: VehicleData) -> dict[str, Float[Array, "14 3"]]:
+    """Hard points of all four corners in the vehicle frame (m).
+
+    Vehicle frame: origin on the ground below the vehicle c.g., x forward, y left, z up.
+    Front corners sit at x = +a, rear at x = -b; right corners mirror y.
+    """
+    mirror = jnp.asarray([1.0, -1.0, 1.0])
+    front = data.hard_points_front.points + jnp.stack([data.a, 0.0 * data.a, 0.0 * data.a])
+    rear = data.hard_points_rear.points - jnp.stack([data.b, 0.0 * data.b, 0.0 * data.b])
+    return {
+        "front_left": front,
+        "front_right": front * mirror,
+        "rear_left": rear,
+        "rear_right": rear * mirror,
+    }
