@@ -1,0 +1,39 @@
+"""Tyres: Magic Formula 5.2 (PAC2002) in pure JAX, ``.tir`` files, relaxation, fitting.
+
+Sign convention ISO-W (see :mod:`jaxveh.tyre._magic_formula`); the mapping to the vehicle
+axes (x forward, y left, z up) is in :mod:`jaxveh.tyre._axes`.
+"""
+
+from ._axes import (
+    forces_to_vehicle as forces_to_vehicle,
+    inclination_angle as inclination_angle,
+    slip_velocities as slip_velocities,
+    velocity_to_wheel as velocity_to_wheel,
+)
+from ._magic_formula import TyreForces as TyreForces, tyre_forces as tyre_forces
+from ._model import (
+    SUPPORTED_FITTYP as SUPPORTED_FITTYP,
+    MagicFormulaTyre as MagicFormulaTyre,
+    coefficient_names as coefficient_names,
+)
+from ._tir import (
+    TirError as TirError,
+    format_tir as format_tir,
+    fsae_tir_path as fsae_tir_path,
+    load_fsae_tyre as load_fsae_tyre,
+    parse_tir as parse_tir,
+    read_tir as read_tir,
+    write_tir as write_tir,
+)
+from ._transient import (
+    low_speed_denominator as low_speed_denominator,
+    relaxation_lengths as relaxation_lengths,
+    steady_slips as steady_slips,
+    transient_slip_rhs as transient_slip_rhs,
+    transient_slips as transient_slips,
+)
+from ._vertical import (
+    effective_rolling_radius as effective_rolling_radius,
+    loaded_radius as loaded_radius,
+    vertical_force as vertical_force,
+)
