@@ -12,6 +12,7 @@ from ._schema import ParameterError, Quantity, check_sections, read_section
 
 _TA1 = "Table A.1"
 _TYRE = "choice, docs/assumptions.md"
+_TA1_DAMPING = "Table A.1 value, read as Nms/rad (docs/assumptions.md)"
 MASS = (
     Quantity("m", "kg", "vehicle total mass", _TA1),
     Quantity("ms", "kg", "sprung mass", _TA1),
@@ -36,14 +37,14 @@ GEOMETRY = (
 SUSPENSION = (
     Quantity("kF", "Nm/deg", "front roll stiffness", _TA1),
     Quantity("kR", "Nm/deg", "rear roll stiffness", _TA1),
-    Quantity("cF", "Nms/deg", "front roll damping", _TA1, lower_open=False),
-    Quantity("cR", "Nms/deg", "rear roll damping", _TA1, lower_open=False),
+    Quantity("cF", "Nms/rad", "front roll damping", _TA1_DAMPING, lower_open=False),
+    Quantity("cR", "Nms/rad", "rear roll damping", _TA1_DAMPING, lower_open=False),
     Quantity("epsF", "-", "front roll steer coefficient", _TA1, lower=-1.0, upper=1.0),
     Quantity("epsR", "-", "rear roll steer coefficient", _TA1, lower=-1.0, upper=1.0),
 )
 CHASSIS = (
     Quantity("kC", "Nm/deg", "chassis torsional stiffness", _TA1),
-    Quantity("cC", "Nms/deg", "chassis torsional damping", _TA1, lower_open=False),
+    Quantity("cC", "Nms/rad", "chassis torsional damping", _TA1_DAMPING, lower_open=False),
 )
 INERTIA = (
     Quantity("JrF", "kg m2", "front half roll inertia", _TA1),

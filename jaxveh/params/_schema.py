@@ -25,6 +25,7 @@ UNIT_TO_SI: dict[str, float] = {
     "Nm/deg": 180.0 / math.pi,
     "Nms/deg": 180.0 / math.pi,
     "Nm/rad": 1.0,
+    "Nms/rad": 1.0,
     "1/rad": 1.0,
     "1/deg": 180.0 / math.pi,
     "m/s": 1.0,
