@@ -9,6 +9,9 @@ app = typer.Typer(
 )
 
 # Sub-command groups are registered below, one line each.
+from ._analytic import app as analytic_app  # noqa: E402
+
+app.add_typer(analytic_app, name="analytic")
 
 
 def main() -> None:
