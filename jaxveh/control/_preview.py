@@ -118,6 +118,7 @@ def preview_plant(
     return PreviewPlant(a=a, b=b, e=e, c=c, n_filter=nf, n_vehicle=n, n_preview=n_preview)
 
 
+@eqx.filter_jit
 def preview_controller(
     a_c: Float[Array, "n n"],
     b_c: Float[Array, "n 1"] | Float[Array, " n"],

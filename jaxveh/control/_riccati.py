@@ -147,6 +147,7 @@ def _attach_jvp(doublings, primals, tangents):
 
 
 
+@eqx.filter_jit
 def solve_dare(
     a: Float[Array, "n n"],
     b: Float[Array, "n m"],
