@@ -135,10 +135,10 @@ class AnalyticVehicle(eqx.Module):
         return self.a + self.b
 
 
-def _check_close(where: str, name: str, value: float, expected: float, formula: str) -> None:
+def _check_close(where: str, name: str, value: float, expected: float, formula: str, unit: str) -> None:
     if abs(value - expected) > CONSISTENCY_RTOL * abs(expected):
         raise ParameterError(
-            f"{where}: {name} = {value:g} is inconsistent with {formula} = {expected:g} "
+            f"{where}: {name} = {value:g} {unit} is inconsistent with {formula} = {expected:g} {unit} "
             f"(relative tolerance {CONSISTENCY_RTOL:g})"
         )
 
@@ -150,9 +150,9 @@ def analytic_vehicle_from_dict(table: dict, where: str = "<dict>") -> AnalyticVe
     for section, quantities in SCHEMA.items():
         v[section] = read_section(table, section, quantities, where)
     ms, g = v["mass"], v["geometry"]
-    _check_close(where, "[mass].m", ms["m"], ms["ms"] + ms["muF"] + ms["muR"], "ms + muF + muR")
-    _check_close(where, "[geometry].l", g["l"], g["a"] + g["b"], "a + b (c.g. must lie inside the wheelbase)")
-    _check_close(where, "[geometry].l", g["l"], g["as"] + g["bs"], "as + bs (sprung c.g. must lie inside the wheelbase)")
+    _check_close(where, "[mass].m", ms["m"], ms["ms"] + ms["muF"] + ms["muR"], "ms + muF + muR", "kg")
+    _check_close(where, "[geometry].l", g["l"], g["a"] + g["b"], "a + b (c.g. must lie inside the wheelbase)", "m")
+    _check_close(where, "[geometry].l", g["l"], g["as"] + g["bs"], "as + bs (sprung c.g. must lie inside the wheelbase)", "m")
     for key in ("hsF", "hsR"):
         roll_centre = g["zF"] if key == "hsF" else g["zR"]
         if g[key] <= roll_centre:

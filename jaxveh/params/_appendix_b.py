@@ -186,9 +186,10 @@ def hard_points_vehicle_frame(data: VehicleData) -> dict[str, Float[Array, "14 3
     Vehicle frame: origin on the ground below the vehicle c.g., x forward, y left, z up.
     Front corners sit at x = +a, rear at x = -b; right corners mirror y.
     """
-    mirror = jnp.asarray([1.0, -1.0, 1.0])
-    front = data.hard_points_front.points + jnp.stack([data.a, 0.0 * data.a, 0.0 * data.a])
-    rear = data.hard_points_rear.points - jnp.stack([data.b, 0.0 * data.b, 0.0 * data.b])
+    mirror = jnp.asarray([[1.0, -1.0, 1.0]])
+    x_axis = jnp.asarray([[1.0, 0.0, 0.0]])
+    front = data.hard_points_front.points + data.a * x_axis
+    rear = data.hard_points_rear.points - data.b * x_axis
     return {
         "front_left": front,
         "front_right": front * mirror,
