@@ -12,6 +12,8 @@ app = typer.Typer(
 from ._analytic import app as analytic_app  # noqa: E402
 
 app.add_typer(analytic_app, name="analytic")
+from ._tyre import app as tyre_app  # noqa: E402
+app.add_typer(tyre_app, name="tyre")
 
 
 def main() -> None:

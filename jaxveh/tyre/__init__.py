@@ -10,12 +10,28 @@ from ._axes import (
     slip_velocities as slip_velocities,
     velocity_to_wheel as velocity_to_wheel,
 )
+from ._curves import (
+    PureSlipCurves as PureSlipCurves,
+    combined_slip_curves as combined_slip_curves,
+    peak_table as peak_table,
+    pure_slip_curves as pure_slip_curves,
+)
+from ._fit import (
+    DEFAULT_STAGES as DEFAULT_STAGES,
+    FitReport as FitReport,
+    FitStage as FitStage,
+    TyreMeasurements as TyreMeasurements,
+    fit_tir as fit_tir,
+    read_tyre_csv as read_tyre_csv,
+    write_tyre_csv as write_tyre_csv,
+)
 from ._magic_formula import TyreForces as TyreForces, tyre_forces as tyre_forces
 from ._model import (
     SUPPORTED_FITTYP as SUPPORTED_FITTYP,
     MagicFormulaTyre as MagicFormulaTyre,
     coefficient_names as coefficient_names,
 )
+from ._plot import PANEL_FILES as PANEL_FILES, plot_fig_b1 as plot_fig_b1
 from ._tir import (
     TirError as TirError,
     format_tir as format_tir,

@@ -1,0 +1,106 @@
+"""Characteristic curves of a tyre (the panels of Fig. B.1) and their peaks.
+
+All evaluated with one vmapped, jitted call of :func:`tyre_forces` per curve family.
+"""
+
+from typing import NamedTuple
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+from ._magic_formula import tyre_forces
+from ._model import MagicFormulaTyre
+
+#: Fig. B.1 loads [N] and slip ranges.
+FIG_B1_LOADS: tuple[float, ...] = (250.0, 500.0, 750.0, 1000.0)
+FIG_B1_KAPPA_MAX = 0.3
+FIG_B1_ALPHA_MAX_DEG = 15.0
+FIG_B1_COMBINED_LOAD = 750.0
+
+
+@eqx.filter_jit
+def _sweep(tyre, fz, kappa, alpha, gamma, vx):
+    """Forces on a grid: loads (n_fz,) x points (n,), one gamma and vx."""
+    point = lambda f, k, a: tyre_forces(tyre, f, k, a, gamma, vx)  # noqa: E731
+    per_load = jax.vmap(point, in_axes=(None, 0, 0))
+    return jax.vmap(per_load, in_axes=(0, None, None))(fz, kappa, alpha)
+
+
+class PureSlipCurves(NamedTuple):
+    """Pure-slip curves at several loads: rows are loads, columns slip points."""
+
+    loads: Float[Array, "n_fz"]
+    kappa: Float[Array, "n"]
+    alpha: Float[Array, "n"]
+    fx: Float[Array, "n_fz n"]
+    fy: Float[Array, "n_fz n"]
+    mz: Float[Array, "n_fz n"]
+
+
+def pure_slip_curves(
+    tyre: MagicFormulaTyre,
+    loads=FIG_B1_LOADS,
+    n: int = 601,
+    kappa_max: float = FIG_B1_KAPPA_MAX,
+    alpha_max_deg: float = FIG_B1_ALPHA_MAX_DEG,
+    gamma: float = 0.0,
+) -> PureSlipCurves:
+    """Fx(kappa) at alpha = 0, and Fy(alpha), Mz(alpha) at kappa = 0, at each load [N]."""
+    loads = jnp.asarray(loads, dtype=jnp.float64)
+    kappa = jnp.linspace(-kappa_max, kappa_max, n)
+    alpha = jnp.deg2rad(jnp.linspace(-alpha_max_deg, alpha_max_deg, n))
+    zero = jnp.zeros_like(kappa)
+    g, vx = jnp.asarray(gamma, dtype=jnp.float64), tyre.longvl
+    lon = _sweep(tyre, loads, kappa, zero, g, vx)
+    lat = _sweep(tyre, loads, zero, alpha, g, vx)
+    return PureSlipCurves(loads, kappa, alpha, lon.fx, lat.fy, lat.mz)
+
+
+def combined_slip_curves(
+    tyre: MagicFormulaTyre,
+    fz: float = FIG_B1_COMBINED_LOAD,
+    alphas_deg=(1.0, 2.0, 4.0, 6.0, 8.0, 10.0),
+    n: int = 301,
+    kappa_max: float = FIG_B1_KAPPA_MAX,
+):
+    """Fx and Fy over kappa in [-kappa_max, kappa_max] at each slip angle (both signs) [N]."""
+    a = np.deg2rad(np.asarray(alphas_deg, dtype=np.float64))
+    a = jnp.asarray(np.concatenate([-a[::-1], a]))
+    kappa = jnp.linspace(-kappa_max, kappa_max, n)
+    fzs = jnp.full((a.shape[0],), fz, dtype=jnp.float64)
+    point = lambda f, al, k: tyre_forces(tyre, f, k, al, 0.0, tyre.longvl)  # noqa: E731
+    grid = jax.jit(jax.vmap(jax.vmap(point, in_axes=(None, None, 0)), in_axes=(0, 0, None)))(fzs, a, kappa)
+    return a, kappa, grid.fx, grid.fy
+
+
+def peak_table(tyre: MagicFormulaTyre, loads=FIG_B1_LOADS, n: int = 3001) -> list[dict[str, float]]:
+    """Peak |Fx|, |Fy|, max and min Mz per load, and the slips where they occur.
+
+    Keys: ``fz`` [N], ``fx_peak`` [N] at ``kappa_peak`` [-] (driving side), ``fy_peak``
+    [N] = max |Fy| at ``alpha_peak_deg``, ``mz_max`` / ``mz_min`` [Nm] at
+    ``alpha_mz_max_deg`` / ``alpha_mz_min_deg``; over the Fig. B.1 slip ranges. The Fy
+    peak is searched on the positive slip-angle side (ISO-W: Fy < 0 there).
+    """
+    c = pure_slip_curves(tyre, loads, n=n)
+    kappa, alpha_deg = np.asarray(c.kappa), np.rad2deg(np.asarray(c.alpha))
+    rows = []
+    for i, fz in enumerate(np.asarray(c.loads)):
+        fx, mz = np.asarray(c.fx[i]), np.asarray(c.mz[i])
+        fy = np.where(alpha_deg >= 0.0, np.abs(np.asarray(c.fy[i])), 0.0)
+        rows.append(
+            dict(
+                fz=float(fz),
+                fx_peak=float(fx.max()),
+                kappa_peak=float(kappa[fx.argmax()]),
+                fy_peak=float(fy.max()),
+                alpha_peak_deg=float(alpha_deg[fy.argmax()]),
+                mz_max=float(mz.max()),
+                alpha_mz_max_deg=float(alpha_deg[mz.argmax()]),
+                mz_min=float(mz.min()),
+                alpha_mz_min_deg=float(alpha_deg[mz.argmin()]),
+            )
+        )
+    return rows

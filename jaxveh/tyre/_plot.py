@@ -1,0 +1,70 @@
+"""The four panels of Fig. B.1 for any tyre: Fx-kappa, Fy-alpha, Mz-alpha, Fx-Fy envelope."""
+
+from pathlib import Path
+
+import numpy as np
+
+from ._curves import FIG_B1_COMBINED_LOAD, combined_slip_curves, pure_slip_curves
+from ._model import MagicFormulaTyre
+
+#: File names of the four panels, in the order of Fig. B.1 (a)-(d).
+PANEL_FILES: tuple[str, ...] = ("fx_kappa.png", "fy_alpha.png", "mz_alpha.png", "fx_fy_combined.png")
+
+
+def plot_fig_b1(tyre: MagicFormulaTyre, out_dir: str | Path, title: str = "") -> list[Path]:
+    """Write the four panels of Fig. B.1 as PNGs (and one 2x2 overview) into ``out_dir``.
+
+    Loads 250/500/750/1000 N, camber 0; combined panel at 750 N with slip angles +-1..10 deg
+    over kappa in [-0.3, 0.3]. Signs as computed (ISO-W). Returns the written paths.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    c = pure_slip_curves(tyre)
+    kappa, alpha_deg = np.asarray(c.kappa), np.rad2deg(np.asarray(c.alpha))
+    alphas, _, cfx, cfy = combined_slip_curves(tyre)
+    labels = [f"Fz = {fz:.0f} N" for fz in np.asarray(c.loads)]
+
+    def panel(ax, which):
+        if which == 0:
+            for i, lab in enumerate(labels):
+                ax.plot(kappa, np.asarray(c.fx[i]), label=lab)
+            ax.set(xlabel="κ [-]", ylabel="Fx [N]", title="(a)")
+        elif which == 1:
+            for i, lab in enumerate(labels):
+                ax.plot(alpha_deg, np.asarray(c.fy[i]), label=lab)
+            ax.set(xlabel="α [deg]", ylabel="Fy [N]", title="(b)")
+        elif which == 2:
+            for i, lab in enumerate(labels):
+                ax.plot(alpha_deg, np.asarray(c.mz[i]), label=lab)
+            ax.set(xlabel="α [deg]", ylabel="Mz [Nm]", title="(c)")
+        else:
+            for j, a in enumerate(np.rad2deg(np.asarray(alphas))):
+                ax.plot(np.asarray(cfx[j]), np.asarray(cfy[j]), color="C0", lw=1.0)
+                ax.annotate(f"{a:.0f}°", (float(cfx[j][-1]), float(cfy[j][-1])), fontsize=6)
+            ax.set(xlabel="Fx [N]", ylabel="Fy [N]", title=f"(d) Fz = {FIG_B1_COMBINED_LOAD:.0f} N")
+            ax.set_aspect("equal", adjustable="datalim")
+        if which < 3:
+            ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.3)
+
+    paths = []
+    for which, name in enumerate(PANEL_FILES):
+        fig, ax = plt.subplots(figsize=(5, 4), constrained_layout=True)
+        panel(ax, which)
+        fig.savefig(out / name, dpi=120)
+        plt.close(fig)
+        paths.append(out / name)
+    fig, axes = plt.subplots(2, 2, figsize=(10, 8), constrained_layout=True)
+    for which, ax in enumerate(axes.flat):
+        panel(ax, which)
+    if title:
+        fig.suptitle(title)
+    fig.savefig(out / "fig_b1.png", dpi=120)
+    plt.close(fig)
+    paths.append(out / "fig_b1.png")
+    return paths
