@@ -52,11 +52,16 @@ def roll_angles_normalised(vehicle: AnalyticVehicle, ay) -> tuple[Float[Array, "
 
 
 def chassis_twist(vehicle: AnalyticVehicle, ay) -> Float[Array, ""]:
-    """Chassis twist φC = φF - φR (rad), eq. (3.15)."""
+    """Chassis twist φC = φF - φR (rad), eq. (3.15).
+
+    (3.15) is printed with (λ - ζ) in the numerator; the difference of the two lines of
+    (3.14), which defines φC = φF - φR, gives (ζ - λ): a front-biased roll stiffness
+    (λ > ζ) makes the front roll less than the rear. The consistent sign is used.
+    """
     lam = roll_stiffness_proportion(vehicle)
     mu = normalised_torsional_stiffness(vehicle)
     z = roll_moment_proportion(vehicle)
-    return (lam - z) / (mu + lam - lam**2) * roll_gradient(vehicle) * ay
+    return (z - lam) / (mu + lam - lam**2) * roll_gradient(vehicle) * ay
 
 
 def _tyre_term(vehicle: AnalyticVehicle) -> Float[Array, ""]:
