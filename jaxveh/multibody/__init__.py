@@ -1,0 +1,75 @@
+"""Flexible multibody library (thesis chapter 5) as pure JAX.
+
+Rigid and modal-flexible bodies in reference-point coordinates, link / spherical / revolute
+joints, tree revolute joints, rheonomic inputs, a semi-recursive velocity transformation
+``v = T y`` and the velocity projection ``y = R z + S b`` that turns the constrained DAE
+into an ODE in independent velocities (eq. 5.61). Nothing here knows about vehicles.
+"""
+
+from ._bodies import (
+    FlexOptions as FlexOptions,
+    FlexibleBody as FlexibleBody,
+    RigidBody as RigidBody,
+)
+from ._dynamics import (
+    body_quadratic_forces as body_quadratic_forces,
+    body_torque as body_torque,
+    energy as energy,
+    internal_forces as internal_forces,
+    mass_matrix as mass_matrix,
+    point_force as point_force,
+)
+from ._errors import (
+    AssemblyError as AssemblyError,
+    MultibodyError as MultibodyError,
+    RedundantConstraintError as RedundantConstraintError,
+    SingularMassMatrixError as SingularMassMatrixError,
+)
+from ._kinematics import (
+    body_poses as body_poses,
+    body_rotation as body_rotation,
+    body_velocities as body_velocities,
+    constraint_jacobian as constraint_jacobian,
+    constraints as constraints,
+    marker_input_jacobian as marker_input_jacobian,
+    marker_jacobian as marker_jacobian,
+    marker_positions as marker_positions,
+    point_velocity as point_velocity,
+    recursion_matrix as recursion_matrix,
+    velocity_maps as velocity_maps,
+    velocity_matrix as velocity_matrix,
+    velocity_matrix_b as velocity_matrix_b,
+)
+from ._projection import (
+    Dynamics as Dynamics,
+    Projection as Projection,
+    check_rank as check_rank,
+    dynamics as dynamics,
+    input_values as input_values,
+    multipliers as multipliers,
+    projection as projection,
+)
+from ._rotations import (
+    angular_velocity_matrix as angular_velocity_matrix,
+    axis_angle as axis_angle,
+    rotation_matrix as rotation_matrix,
+    skew as skew,
+)
+from ._simulate import (
+    ASSEMBLY_TOL as ASSEMBLY_TOL,
+    DEFAULT_KAPPA as DEFAULT_KAPPA,
+    ProjectedSolver as ProjectedSolver,
+    Simulation as Simulation,
+    project_coordinates as project_coordinates,
+    assemble as assemble,
+    independent_velocities as independent_velocities,
+    joint_velocities as joint_velocities,
+    simulate as simulate,
+    vector_field as vector_field,
+)
+from ._system import (
+    GROUND as GROUND,
+    System as System,
+    SystemBuilder as SystemBuilder,
+    SystemParams as SystemParams,
+)

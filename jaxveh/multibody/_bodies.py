@@ -1,0 +1,126 @@
+"""Body parameter pytrees: rigid bodies (eqs. 5.22-5.36) and modal flexible bodies (5.37-5.45).
+
+Velocities of a body are expressed in its own moving frame: ``v = [u, omega, p_dot]`` with
+``u`` the velocity of the body reference point and ``omega`` the angular velocity, both in
+body axes (eq. 5.31), and ``p_dot`` the modal velocities of a flexible body.
+"""
+
+from typing import Any
+
+import equinox as eqx
+import jax.numpy as jnp
+from jaxtyping import Array, Float
+
+from ..params import float_field
+from ._rotations import skew
+
+
+class FlexOptions(eqx.Module):
+    """Simplifications of the flexible-body equations (thesis Table 7.2); static flags.
+
+    - ``constant_mass``: use the mass matrix of the undeformed body, ``M(p) = M(0)``;
+    - ``neglect_gyroscopic``: drop the ``Gr`` / ``Ge`` terms of eq. (5.45), i.e. the terms
+      bilinear in the angular and the modal velocities of the rotational and elastic rows;
+    - ``neglect_c``: drop the deformation shift of the centre of mass ``c1 = Ct p / m``.
+    """
+
+    constant_mass: bool = eqx.field(static=True, default=False)
+    neglect_gyroscopic: bool = eqx.field(static=True, default=False)
+    neglect_c: bool = eqx.field(static=True, default=False)
+
+
+class RigidBody(eqx.Module):
+    """A rigid body: mass (kg), inertia tensor about its c.g. in body axes (kg m^2, products
+    of inertia included), and the c.g. position in the body frame (m; zero for a centroidal
+    reference point, the thesis's usual choice)."""
+
+    mass: Float[Array, ""] = float_field()
+    inertia: Float[Array, "3 3"] = float_field()
+    cg: Float[Array, "3"] = float_field(default=(0.0, 0.0, 0.0))
+
+    @property
+    def n_modes(self) -> int:
+        return 0
+
+    def mass_matrix(self, p, options: FlexOptions) -> Float[Array, "6 6"]:
+        """Constant body mass matrix about the reference point (eq. 5.25)."""
+        del p, options
+        m, c = self.mass, self.cg
+        ct = skew(c)
+        j_ref = self.inertia + m * (ct.T @ ct)
+        eye = jnp.eye(3, dtype=m.dtype)
+        return jnp.block([[m * eye, -m * ct], [m * ct, j_ref]])
+
+    def gravity(self, g_body, p, options: FlexOptions) -> Float[Array, "6"]:
+        """Generalised gravity force ``[m g; c x m g]`` with ``g_body`` in body axes (m/s^2)."""
+        del p, options
+        f = self.mass * g_body
+        return jnp.concatenate([f, jnp.cross(self.cg, f)])
+
+    def elastic(self, p, p_dot) -> Float[Array, "0"]:
+        """Elastic and damping forces: none for a rigid body."""
+        del p_dot
+        return jnp.zeros((0,), p.dtype)
+
+    def potential_gravity(self, r, a, p, g):
+        """Gravitational potential energy (J): ``-m g . (r + A c)``."""
+        del p
+        return -self.mass * jnp.dot(g, r + a @ self.cg)
+
+    def potential_elastic(self, p):
+        return jnp.zeros((), p.dtype)
+
+
+class FlexibleBody(eqx.Module):
+    """A flexible body in a floating frame with modal coordinates ``p`` (section 5.4.2).
+
+    ``modal`` is a modal body from the FE module (:class:`jaxveh.fe.ModalBody`: invariants
+    ``mass, c0, J0, Ct, Cr0, C4, C5, Me`` of eqs. 5.38-5.42 in body axes, modal stiffness
+    with its per-mode multiplier ``stiffness_scale``, damping ``alpha Me + beta K``, mode
+    shapes at named points). ``coupling`` (0..1) scales the mode shapes at the body's points
+    (thesis Fig. 7.7). The mass matrix is assembled here from the invariants (eq. 5.37).
+    """
+
+    modal: Any
+    coupling: Float[Array, ""] = float_field(default=1.0)
+
+    @property
+    def n_modes(self) -> int:
+        return self.modal.n_modes
+
+    def mass_matrix(self, p, options: FlexOptions) -> Float[Array, "6+nm 6+nm"]:
+        """Mass matrix of eq. (5.37) at modal coordinates ``p`` (first order in ``p``)."""
+        inv = self.modal.invariants
+        if options.constant_mass:
+            p = jnp.zeros_like(p)
+        m = inv.mass
+        c = inv.c0 if options.neglect_c else inv.c0 + (inv.Ct @ p) / m
+        ct = skew(c)
+        c4 = jnp.einsum("lij,l->ij", inv.C4, p)
+        j = inv.J0 - (c4 + c4.T)
+        cr = inv.Cr0 + jnp.einsum("lij,l->ij", inv.C5, p)
+        eye = jnp.eye(3, dtype=m.dtype)
+        return jnp.block([[m * eye, -m * ct, inv.Ct], [m * ct, j, cr], [inv.Ct.T, cr.T, inv.Me]])
+
+    def _com_moment(self, p):
+        """``m c(p) = m c0 + Ct p`` (kg m, body axes)."""
+        inv = self.modal.invariants
+        return inv.mass * inv.c0 + inv.Ct @ p
+
+    def gravity(self, g_body, p, options: FlexOptions):
+        """Generalised gravity force of eq. (5.43) with ``g_body`` in body axes (m/s^2)."""
+        inv = self.modal.invariants
+        mc = inv.mass * inv.c0 if options.neglect_c else self._com_moment(p)
+        return jnp.concatenate([inv.mass * g_body, jnp.cross(mc, g_body), inv.Ct.T @ g_body])
+
+    def elastic(self, p, p_dot):
+        """Elastic and damping generalised forces ``-(K p + D p_dot)`` (eq. 5.44)."""
+        return self.modal.elastic_forces(p, p_dot)
+
+    def potential_gravity(self, r, a, p, g):
+        """Gravitational potential energy (J): ``-g . (m r + A (m c0 + Ct p))``."""
+        return -jnp.dot(g, self.modal.invariants.mass * r + a @ self._com_moment(p))
+
+    def potential_elastic(self, p):
+        """Strain energy ``p^T K p / 2`` (J)."""
+        return 0.5 * p @ (self.modal.stiffness_matrix() @ p)

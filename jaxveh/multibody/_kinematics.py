@@ -1,0 +1,215 @@
+"""Kinematics: body poses, points (eqs. 5.6, 5.12-5.13), the velocity recursion ``v = T y``
+(eqs. 5.47-5.49), ``q_dot = B T y`` (eq. 5.31) and the constraints ``Phi`` (eqs. 5.15-5.17).
+
+All functions are pure in ``(system, params, q, ...)``; the loops below run over the static
+topology and are unrolled once at trace time.
+"""
+
+import jax
+import jax.numpy as jnp
+from jaxtyping import Array, Float
+
+from ._rotations import angular_velocity_matrix, axis_angle, rotation_matrix
+from ._system import FREE, System, SystemParams
+
+
+def _split(system: System, x, offsets):
+    return [x[offsets[i] : offsets[i + 1]] for i in range(system.n_bodies)]
+
+
+def body_poses(system: System, params: SystemParams, q: Float[Array, " nq"]) -> list[tuple]:
+    """``[(r_i, A_i, p_i)]`` for every body: origin (m, global), rotation, modal coordinates."""
+    poses = []
+    for i, qi in enumerate(_split(system, q, system.q_offsets)):
+        if system.tree_kind[i] == FREE:
+            poses.append((qi[:3], rotation_matrix(system.sequence[i], qi[3:6]), qi[6:]))
+        else:
+            rp, ap = _parent_pose(poses, system.parent[i], q.dtype)
+            joint = params.tree[i]
+            poses.append((rp + ap @ joint.offset, ap @ axis_angle(joint.axis, qi[0]), qi[1:]))
+    return poses
+
+
+def _parent_pose(poses, parent: int, dtype):
+    if parent < 0:
+        return jnp.zeros((3,), dtype), jnp.eye(3, dtype=dtype)
+    return poses[parent][0], poses[parent][1]
+
+
+def _inputs_or_empty(u, dtype):
+    return jnp.zeros((0,), dtype) if u is None else u
+
+
+def point_local(system: System, params: SystemParams, poses, k: int, u) -> Float[Array, "3"]:
+    """Position of point ``k`` in its body frame including deformation and input (m)."""
+    point, body = params.points[k], system.point_body[k]
+    x = point.position
+    if body >= 0 and system.n_modes[body] > 0:
+        x = x + params.bodies[body].coupling * (point.shapes @ poses[body][2])
+    if system.point_input[k] >= 0:
+        x = x + u[system.point_input[k]] * point.input_direction
+    return x
+
+
+def point_position(system: System, params: SystemParams, poses, k: int, u) -> Float[Array, "3"]:
+    """Global position of point ``k`` (m), eqs. (5.6) and (5.12)."""
+    x = point_local(system, params, poses, k, u)
+    body = system.point_body[k]
+    if body < 0:
+        return x
+    r, a, _ = poses[body]
+    return r + a @ x
+
+
+def marker_positions(system: System, params: SystemParams, q, u=None) -> Float[Array, "np 3"]:
+    """``pX``: global positions (m) of all points, one row per point."""
+    poses = body_poses(system, params, q)
+    u = _inputs_or_empty(u, q.dtype)
+    if not system.point_names:
+        return jnp.zeros((0, 3), q.dtype)
+    return jnp.stack([point_position(system, params, poses, k, u) for k in range(len(system.point_names))])
+
+
+def body_rotation(system: System, params: SystemParams, q, body: str) -> Float[Array, "3 3"]:
+    """Body-to-global rotation matrix of ``body``."""
+    return body_poses(system, params, q)[system.body_names.index(body)][1]
+
+
+def _orthonormal_pair(n1):
+    """Two unit vectors orthogonal to the unit ``n1`` and to each other (smooth away from the
+    switching planes; the helper axis is the coordinate axis least aligned with ``n1``)."""
+    helpers = jnp.eye(3, dtype=n1.dtype)
+    h = helpers[jnp.argmin(jnp.abs(n1))]
+    n2 = jnp.cross(n1, h)
+    n2 = n2 / jnp.linalg.norm(n2)
+    return n2, jnp.cross(n1, n2)
+
+
+def constraints(system: System, params: SystemParams, q, u=None) -> Float[Array, " m"]:
+    """``pPhi``: constraint residuals (eqs. 5.15-5.17), m for positions, dimensionless for axes.
+
+    Link rows use ``(|d|^2 - l^2) / (2 l)``, equal to ``|d| - l`` to first order and smooth.
+    """
+    poses = body_poses(system, params, q)
+    u = _inputs_or_empty(u, q.dtype)
+    rows = []
+    for k, kind in enumerate(system.joint_kind):
+        i, j = system.joint_points[k]
+        d = point_position(system, params, poses, i, u) - point_position(system, params, poses, j, u)
+        jp = params.joints[k]
+        if kind == "spherical":
+            rows.append(jnp.stack([d[c] for c in system.joint_components[k]]))
+        elif kind == "link":
+            rows.append(jnp.reshape((d @ d - jp.length**2) / (2.0 * jp.length), (1,)))
+        else:
+            ai = _point_rotation(system, poses, i)
+            aj = _point_rotation(system, poses, j)
+            n2, n3 = _orthonormal_pair(jp.axis_i)
+            n1j = aj @ jp.axis_j
+            rows.append(jnp.concatenate([d, jnp.stack([(ai @ n2) @ n1j, (ai @ n3) @ n1j])]))
+    if not rows:
+        return jnp.zeros((0,), q.dtype)
+    return jnp.concatenate(rows)
+
+
+def _point_rotation(system: System, poses, k: int):
+    body = system.point_body[k]
+    return jnp.eye(3, dtype=poses[0][0].dtype) if body < 0 else poses[body][1]
+
+
+def body_velocities(system: System, params: SystemParams, q, y, poses=None) -> list:
+    """``v = T y`` (eq. 5.49): body-frame velocities ``[u, omega, p_dot]`` of every body."""
+    poses = body_poses(system, params, q) if poses is None else poses
+    vs = []
+    for i, yi in enumerate(_split(system, y, system.q_offsets)):
+        parent = system.parent[i]
+        r, a, _ = poses[i]
+        if parent < 0:
+            u_p = jnp.zeros((3,), q.dtype)
+            w_p = jnp.zeros((3,), q.dtype)
+            a_rel = a.T
+            r_rel = r
+        else:
+            rp, ap, _ = poses[parent]
+            u_p, w_p = vs[parent][:3], vs[parent][3:6]
+            a_rel = a.T @ ap  # parent axes -> child axes, A(i, i-1) of eq. (5.48)
+            r_rel = ap.T @ (r - rp)  # child origin from parent origin, parent axes
+        u_c = a_rel @ (u_p + jnp.cross(w_p, r_rel))
+        w_c = a_rel @ w_p
+        if system.tree_kind[i] == FREE:
+            vs.append(jnp.concatenate([u_c + yi[:3], w_c + yi[3:6], yi[6:]]))
+        else:
+            axis = params.tree[i].axis
+            vs.append(jnp.concatenate([u_c, w_c + yi[0] * axis, yi[1:]]))
+    return vs
+
+
+def qdot_from_velocities(system: System, params: SystemParams, q, y, vs, poses) -> Float[Array, " nq"]:
+    """``q_dot = B v`` for free bodies (eq. 5.31) and the joint rates for tree joints."""
+    ys = _split(system, y, system.q_offsets)
+    out = []
+    for i in range(system.n_bodies):
+        if system.tree_kind[i] == FREE:
+            _, a, _ = poses[i]
+            qi = q[system.q_offsets[i] : system.q_offsets[i] + 6]
+            gr = angular_velocity_matrix(system.sequence[i], qi[3:6])
+            out.append(jnp.concatenate([a @ vs[i][:3], jnp.linalg.solve(gr, vs[i][3:6]), vs[i][6:]]))
+        else:
+            out.append(ys[i])
+    return jnp.concatenate(out)
+
+
+def velocity_maps(system: System, params: SystemParams, q, y):
+    """``(v, q_dot)`` for joint velocities ``y``: ``v = T y`` and ``q_dot = B T y``."""
+    poses = body_poses(system, params, q)
+    vs = body_velocities(system, params, q, y, poses)
+    return jnp.concatenate(vs), qdot_from_velocities(system, params, q, y, vs, poses)
+
+
+def recursion_matrix(system: System, params: SystemParams, q) -> Float[Array, "nv ny"]:
+    """``pT``: the recursion matrix ``T`` of eq. (5.50), ``v = T y``."""
+    return jax.jacfwd(lambda y: velocity_maps(system, params, q, y)[0])(jnp.zeros((system.n_y,), q.dtype))
+
+
+def velocity_matrix(system: System, params: SystemParams, q) -> Float[Array, "nq ny"]:
+    """``B T``: ``q_dot = (B T) y`` (eqs. 5.31, 5.49)."""
+    return jax.jacfwd(lambda y: velocity_maps(system, params, q, y)[1])(jnp.zeros((system.n_y,), q.dtype))
+
+
+def velocity_matrix_b(system: System, params: SystemParams, q) -> Float[Array, "nq nv"]:
+    """``pB`` for systems of free bodies only: ``q_dot = B v`` (block diagonal, eq. 5.31)."""
+    if any(k != FREE for k in system.tree_kind):
+        raise ValueError("B (q_dot = B v) exists only for systems of free bodies; use velocity_matrix (B T)")
+    poses = body_poses(system, params, q)
+    y0 = jnp.zeros((system.n_y,), q.dtype)
+
+    def qdot(v):
+        return qdot_from_velocities(system, params, q, y0, _split(system, v, system.v_offsets), poses)
+
+    return jax.jacfwd(qdot)(jnp.zeros((system.n_v,), q.dtype))
+
+
+def constraint_jacobian(system: System, params: SystemParams, q, u=None) -> Float[Array, "m nq"]:
+    """``Phi_q`` by forward-mode autodiff."""
+    return jax.jacfwd(lambda qq: constraints(system, params, qq, u))(q)
+
+
+def marker_jacobian(system: System, params: SystemParams, q, u=None) -> Float[Array, "np 3 nq"]:
+    """``pdXdq``: derivative of the point positions versus ``q``."""
+    return jax.jacfwd(lambda qq: marker_positions(system, params, qq, u))(q)
+
+
+def marker_input_jacobian(system: System, params: SystemParams, q, u) -> Float[Array, "np 3 ni"]:
+    """``pdXdd``: derivative of the point positions versus the rheonomic inputs."""
+    return jax.jacfwd(lambda uu: marker_positions(system, params, q, uu))(u)
+
+
+def point_velocity(system: System, params: SystemParams, q, y, point: str, u=None, u_dot=None):
+    """Global velocity (m/s) of ``point`` for joint velocities ``y`` (and input rates)."""
+    k = system.point_index(point)
+    u = _inputs_or_empty(u, q.dtype)
+    u_dot = jnp.zeros_like(u) if u_dot is None else u_dot
+    _, q_dot = velocity_maps(system, params, q, y)
+    f = lambda qq, uu: marker_positions(system, params, qq, uu)[k]  # noqa: E731
+    return jax.jvp(f, (q, u), (q_dot, u_dot))[1]
+

@@ -1,0 +1,224 @@
+"""Velocity projection (coordinate reduction, eqs. 5.52-5.62) and the reduced equations of
+motion (5.61); Lagrange multipliers; rank and mass-matrix checks.
+
+With joint velocities ``y`` (eq. 5.47), ``[Phi_q B T; P] y = [b; z]`` (5.54) is factorised
+once per evaluation (LU) and reused for ``R``, ``S b`` and ``S c`` (5.62); ``S`` itself is
+never formed. Drift control (documented choice): the velocity equation uses
+``b = -Phi_t - kappa Phi`` so that along every solution ``Phi_dot = -kappa Phi`` (a first
+order, Baumgarte-type stabilisation at velocity level, exact in the projection and free of
+iterations); ``c`` is the consistent time derivative, so ``z`` still obeys eq. (5.61)
+exactly when ``Phi = 0``.
+"""
+
+from collections.abc import Callable
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+from ._dynamics import internal_forces, mass_matrix
+from ._errors import RedundantConstraintError
+from ._kinematics import constraints, velocity_maps
+from ._system import System, SystemParams
+
+Inputs = Callable[[Float[Array, ""]], Float[Array, " ni"]]
+External = Callable[..., Float[Array, " nv"]]
+
+
+def input_values(system: System, inputs: Inputs | None, t, dtype=jnp.float64):
+    """Rheonomic input values ``u(t)``; an empty vector for a system without inputs."""
+    if system.n_inputs == 0:
+        return jnp.zeros((0,), dtype)
+    if inputs is None:
+        raise ValueError(f"system has inputs {system.input_names}; pass an `inputs(t)` function")
+    return jnp.asarray(inputs(t), dtype=dtype)
+
+
+def _phi_of(system, params, inputs):
+    def phi(q, t):
+        return constraints(system, params, q, input_values(system, inputs, t, q.dtype))
+
+    return phi
+
+
+def _selection(system: System, dtype) -> Float[Array, "ndof ny"]:
+    """``P`` of eq. (5.52): the boolean matrix that extracts the independent velocities."""
+    return jnp.asarray(np.eye(system.n_y)[list(system.independent)], dtype=dtype)
+
+
+class Projection(eqx.Module):
+    """Kinematic quantities at one state (thesis Table 5.3 and eqs. 5.54-5.62).
+
+    ``phi`` constraint residuals, ``phi_q`` their Jacobian, ``T`` recursion matrix,
+    ``BT`` with ``q_dot = B T y``, ``R`` projection (null-space) matrix, ``Sb`` particular
+    velocity solution, ``lu`` the LU factors of ``[Phi_q B T; P]``.
+    """
+
+    phi: Float[Array, " m"]
+    phi_q: Float[Array, "m nq"]
+    T: Float[Array, "nv ny"]
+    BT: Float[Array, "nq ny"]
+    R: Float[Array, "ny ndof"]
+    Sb: Float[Array, " ny"]
+    lu: tuple
+
+
+def projection(
+    system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, kappa=0.0
+) -> Projection:
+    """Constraint Jacobians, ``T``, ``B T`` and the projection ``R``, ``S b`` (eq. 5.54)."""
+    t = jnp.asarray(t, q.dtype)
+    phi_fn = _phi_of(system, params, inputs)
+    phi, phi_t = jax.jvp(lambda tt: phi_fn(q, tt), (t,), (jnp.ones_like(t),))
+    phi_q = jax.jacfwd(phi_fn)(q, t)
+    t_mat, bt = jax.jacfwd(lambda y: velocity_maps(system, params, q, y))(jnp.zeros((system.n_y,), q.dtype))
+    m, ndof = system.n_constraints, system.n_dof
+    a = jnp.concatenate([phi_q @ bt, _selection(system, q.dtype)])
+    lu = jax.scipy.linalg.lu_factor(a)
+    b = -phi_t - kappa * phi
+    rhs = jnp.block([[b[:, None], jnp.zeros((m, ndof), q.dtype)], [jnp.zeros((ndof, 1), q.dtype), jnp.eye(ndof)]])
+    sol = jax.scipy.linalg.lu_solve(lu, rhs)
+    sol = eqx.error_if(
+        sol,
+        ~jnp.all(jnp.isfinite(sol)),
+        "[Phi_q B T; P] is singular: redundant constraints or dependent independent velocities "
+        "(call jaxveh.multibody.check_rank at this state for the names)",
+    )
+    return Projection(phi=phi, phi_q=phi_q, T=t_mat, BT=bt, R=sol[:, 1:], Sb=sol[:, 0], lu=lu)
+
+
+def _velocity_constraint(system, params, inputs, y, kappa):
+    """``h(q, t) = Phi_q B T y + Phi_t + kappa Phi`` with ``y`` held fixed."""
+    phi_fn = _phi_of(system, params, inputs)
+
+    def h(q, t):
+        q_dot = velocity_maps(system, params, q, y)[1]
+        phi, phi_dot = jax.jvp(phi_fn, (q, t), (q_dot, jnp.ones_like(t)))
+        return phi_dot + kappa * phi
+
+    return h
+
+
+class Dynamics(eqx.Module):
+    """Everything eq. (5.61) produces at one state.
+
+    ``y`` joint velocities, ``v`` body velocities, ``q_dot``, ``z_dot`` independent
+    accelerations, ``mass_matrix`` the reduced ``R^T T^T M T R``, ``internal_forces`` the
+    reduced velocity/elastic/damping forces ``R^T T^T (Q_v + Q_e - M (T_dot y + T S c))``,
+    ``external_forces`` the reduced gravity + applied forces, ``y_dot``, ``v_dot``, ``Sc``.
+    """
+
+    projection: Projection
+    y: Float[Array, " ny"]
+    v: Float[Array, " nv"]
+    q_dot: Float[Array, " nq"]
+    z_dot: Float[Array, " ndof"]
+    y_dot: Float[Array, " ny"]
+    v_dot: Float[Array, " nv"]
+    Sc: Float[Array, " ny"]
+    mass_matrix: Float[Array, "ndof ndof"]
+    internal_forces: Float[Array, " ndof"]
+    external_forces: Float[Array, " ndof"]
+    full_mass_matrix: Float[Array, "nv nv"]
+    forces: Float[Array, " nv"]
+
+
+def dynamics(
+    system: System,
+    params: SystemParams,
+    q,
+    z,
+    t=0.0,
+    inputs: Inputs | None = None,
+    external: External | None = None,
+    args=None,
+    kappa=0.0,
+) -> Dynamics:
+    """Reduced equations of motion (eq. 5.61) at ``(q, z, t)``.
+
+    ``external(q, v, t, args)`` returns applied generalised forces in ``v`` coordinates (use
+    :func:`point_force` / :func:`body_torque`); gravity is built in (``params.gravity``).
+    """
+    t = jnp.asarray(t, q.dtype)
+    proj = projection(system, params, q, t, inputs, kappa)
+    y = proj.R @ z + proj.Sb
+    v, q_dot = proj.T @ y, proj.BT @ y
+    h = _velocity_constraint(system, params, inputs, y, kappa)
+    c = -jax.jvp(h, (q, t), (q_dot, jnp.ones_like(t)))[1]
+    rhs_c = jnp.concatenate([c, jnp.zeros((system.n_dof,), q.dtype)])
+    sc = jax.scipy.linalg.lu_solve(proj.lu, rhs_c)
+    t_dot_y = jax.jvp(lambda qq: velocity_maps(system, params, qq, y)[0], (q,), (q_dot,))[1]
+    a0 = proj.T @ sc + t_dot_y  # body accelerations at z_dot = 0
+    tr = proj.T @ proj.R
+    m_full = mass_matrix(system, params, q)
+    q_int, q_grav = internal_forces(system, params, q, v)
+    q_ext = q_grav if external is None else q_grav + external(q, v, t, args)
+    m_red = tr.T @ m_full @ tr
+    f_int = tr.T @ (q_int - m_full @ a0)
+    f_ext = tr.T @ q_ext
+    chol = jnp.linalg.cholesky(m_red)
+    chol = eqx.error_if(
+        chol,
+        ~jnp.all(jnp.isfinite(chol)),
+        "reduced mass matrix R^T T^T M T R is singular or not positive definite",
+    )
+    z_dot = jax.scipy.linalg.cho_solve((chol, True), f_int + f_ext)
+    y_dot = proj.R @ z_dot + sc
+    return Dynamics(
+        projection=proj,
+        y=y,
+        v=v,
+        q_dot=q_dot,
+        z_dot=z_dot,
+        y_dot=y_dot,
+        v_dot=tr @ z_dot + a0,
+        Sc=sc,
+        mass_matrix=m_red,
+        internal_forces=f_int,
+        external_forces=f_ext,
+        full_mass_matrix=m_full,
+        forces=q_int + q_ext,
+    )
+
+
+def multipliers(system: System, dyn: Dynamics) -> Float[Array, " m"]:
+    """Lagrange multipliers ``lambda = S^T T^T (Q - M v_dot)`` (thesis after eq. 5.61).
+
+    Convention: ``T^T M v_dot + (Phi_q B T)^T lambda = T^T Q``. The generalised constraint
+    force on the bodies is ``-(d Phi / d x)^T lambda``: for a link, ``lambda`` is its tension
+    (N, positive pulls the two points together); for a spherical joint, ``-lambda`` is the
+    force (N, global axes) on the first point's body.
+    """
+    resid = dyn.projection.T.T @ (dyn.forces - dyn.full_mass_matrix @ dyn.v_dot)
+    return jax.scipy.linalg.lu_solve(dyn.projection.lu, resid, trans=1)[: system.n_constraints]
+
+
+def check_rank(system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, tol=1e-9) -> None:
+    """Raise :class:`RedundantConstraintError` naming the joints or velocities at fault when
+    ``[Phi_q B T; P]`` loses rank at ``q`` (Python-level check on concrete values)."""
+    proj = projection(system, params, jnp.asarray(q), t, inputs)
+    phi_y = np.asarray(proj.phi_q @ proj.BT)
+    names_c, names_y = system.constraint_names, system.y_names
+    if phi_y.shape[0] > 0:
+        u, s, _ = np.linalg.svd(phi_y)
+        scale = max(float(s[0]), 1.0)
+        if s[-1] < tol * scale or len(s) < phi_y.shape[0]:
+            null = u[:, -1]
+            bad = [names_c[k] for k in np.flatnonzero(np.abs(null) > 0.1 * np.abs(null).max())]
+            raise RedundantConstraintError(
+                f"constraints are redundant (Phi_q B T rank {int(np.sum(s > tol * scale))} < "
+                f"{phi_y.shape[0]} equations); dependent equations: {bad}"
+            )
+    a = np.concatenate([phi_y, np.eye(system.n_y)[list(system.independent)]])
+    _, s, vt = np.linalg.svd(a)
+    scale = max(float(s[0]), 1.0)
+    if s[-1] < tol * scale:
+        null = vt[-1]
+        moving = [names_y[k] for k in np.flatnonzero(np.abs(null) > 0.1 * np.abs(null).max())]
+        chosen = [names_y[k] for k in system.independent]
+        raise RedundantConstraintError(
+            f"independent velocities {chosen} are dependent at this configuration: the joint "
+            f"velocities {moving} can move with all of them held at zero; declare another set"
+        )
