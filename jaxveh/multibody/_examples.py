@@ -170,3 +170,266 @@ def four_bar_angles(crank_angle, values: dict | None = None):
     coupler = np.arctan2(e[1] - a[1], e[0] - a[0])
     rocker = np.arctan2(e[1] - o_b[1], e[0] - o_b[0])
     return coupler, rocker
+
+
+# ---------------------------------------------------------------------------------------
+# Quarter car (section 6.1, Tables 6.2-6.3, Appendix B hard points)
+# ---------------------------------------------------------------------------------------
+
+#: Wheel-centre height (m) of the quarter car: the thesis's unsprung c.g. height. The
+#: wheel centre sits at x = 0 (axle centre) and y = track / 2 in the corner frame.
+WHEEL_CENTRE_HEIGHT = 0.255
+#: Links of the double wishbone (Table 6.3): (name, chassis point, upright point).
+QUARTER_CAR_LINKS = (
+    ("lower_rear", "A", "C"),
+    ("lower_front", "B", "C"),
+    ("upper_rear", "E", "H"),
+    ("upper_front", "F", "H"),
+    ("track_rod", "L", "M"),
+)
+_CHASSIS_POINTS = ("A", "B", "E", "F", "L")
+_UPRIGHT_POINTS = ("C", "H", "M")
+
+
+def _hard_point(points, name):
+    from ..params import HARD_POINT_NAMES
+
+    return points[HARD_POINT_NAMES.index(name)]
+
+
+def quarter_car(data=None, axle: str = "front") -> tuple[System, SystemParams]:
+    """Front-left (or rear-left) quarter car from the Appendix B hard points.
+
+    Chassis fixed (ground, corner frame of ``jaxveh.params``: origin on the ground below the
+    axle centre in the vehicle centre plane, x forward, y left, z up). The upright (unsprung
+    mass, toe-camber-spin sequence ``"zxy"``, reference point and c.g. at the wheel centre
+    ``W = (0, track/2, WHEEL_CENTRE_HEIGHT)``) is held by the five links of Table 6.3; the
+    wheel spins on it (tree revolute joint about the upright y axis; its mass is lumped in
+    the upright, it carries the spin inertia). The steering input ``rack`` (m) moves the
+    inner track-rod joint L along the chassis y axis: the rack carries L (Table 6.2 puts L on
+    the sprung side); the thesis's wording "moves points M" describes the same rack.
+    Independent velocities: ``upright.uz`` (bump) and ``wheel.theta_dot`` (spin).
+    """
+    from ..params import load_vehicle_data
+
+    data = load_vehicle_data() if data is None else data
+    hp = (data.hard_points_front if axle == "front" else data.hard_points_rear).points
+    unsprung = data.unsprung_front if axle == "front" else data.unsprung_rear
+    track = data.track_front if axle == "front" else data.track_rear
+    w = np.array([0.0, float(track) / 2.0, WHEEL_CENTRE_HEIGHT])
+    b = SystemBuilder(gravity=(0.0, 0.0, -9.81))
+    b.add_input("rack")
+    b.add_rigid_body("upright", float(unsprung.body.mass), np.asarray(unsprung.body.inertia), rotation="zxy")
+    spin = float(unsprung.wheel_spin_inertia)
+    b.add_rigid_body("wheel", 0.0, np.diag([0.0, spin, 0.0]), parent="upright", revolute=((0, 0, 0), (0, 1, 0)))
+    for name in _CHASSIS_POINTS:
+        kwargs = {"input": "rack", "input_direction": (0.0, 1.0, 0.0)} if name == "L" else {}
+        b.add_point(name, "ground", np.asarray(_hard_point(hp, name)), **kwargs)
+    for name in _UPRIGHT_POINTS:
+        b.add_point(name, "upright", np.asarray(_hard_point(hp, name)) - w)
+    for link, p, q in QUARTER_CAR_LINKS:
+        length = np.linalg.norm(np.asarray(_hard_point(hp, p)) - np.asarray(_hard_point(hp, q)))
+        b.add_link(link, p, q, length)
+    b.add_independent("upright", "uz")
+    b.add_independent("wheel", "theta_dot")
+    return b.build()
+
+
+def quarter_car_design_q(system: System, wheel_centre=None):
+    """Design-position coordinates: upright at the wheel centre, zero angles, zero spin."""
+    w = jnp.asarray([0.0, 0.63, WHEEL_CENTRE_HEIGHT]) if wheel_centre is None else jnp.asarray(wheel_centre)
+    return jnp.concatenate([w, jnp.zeros((system.n_q - 3,))])
+
+
+def quarter_car_with_hard_points(system: System, params: SystemParams, hard_points, wheel_centre) -> SystemParams:
+    """Parameters for new hard points (14 x 3, m, corner frame) and wheel centre (m): point
+    positions and link lengths recomputed with JAX, so gradients flow to the hard points."""
+    import equinox as eqx
+
+    hard_points, w = jnp.asarray(hard_points), jnp.asarray(wheel_centre)
+    points = list(params.points)
+    for name in _CHASSIS_POINTS:
+        k = system.point_index(name)
+        points[k] = eqx.tree_at(lambda p: p.position, points[k], _hard_point(hard_points, name))
+    for name in _UPRIGHT_POINTS:
+        k = system.point_index(name)
+        points[k] = eqx.tree_at(lambda p: p.position, points[k], _hard_point(hard_points, name) - w)
+    joints = list(params.joints)
+    for link, p, q in QUARTER_CAR_LINKS:
+        k = system.joint_names.index(link)
+        length = jnp.linalg.norm(_hard_point(hard_points, p) - _hard_point(hard_points, q))
+        joints[k] = eqx.tree_at(lambda j: j.length, joints[k], length)
+    return eqx.tree_at(lambda s: (s.points, s.joints), params, (tuple(points), tuple(joints)))
+
+
+def wheel_angles(system: System, params: SystemParams, q):
+    """Camber and toe-in (rad) of the left wheel from its spin axis ``a`` (global):
+    camber = atan2(-a_z, a_y) (positive top outwards), toe-in = atan2(a_x, a_y)."""
+    from ._kinematics import body_poses
+
+    a = body_poses(system, params, q)[system.body_names.index("upright")][1][:, 1]
+    return jnp.arctan2(-a[2], a[1]), jnp.arctan2(a[0], a[1])
+
+
+def quarter_car_kinematics(system: System, params: SystemParams, bump, rack, wheel_centre=None, iterations=25):
+    """Assemble the quarter car at wheel-centre vertical travel ``bump`` (m) and rack travel
+    ``rack`` (m); returns ``(q, outputs)`` with camber and toe-in (rad), wheel-centre
+    position (m) and track (m, twice the wheel-centre y) and the max constraint residual."""
+    from ._kinematics import constraints
+    from ._simulate import assemble
+
+    q0 = quarter_car_design_q(system, wheel_centre)
+    iz = system.q_index("upright", "z")
+    q_guess = q0.at[iz].add(bump)
+    fixed = (iz, system.q_index("wheel", "theta"))
+    rack = jnp.asarray(rack, jnp.float64)
+    inputs = lambda t: jnp.reshape(rack, (1,))  # noqa: E731
+    q = assemble(system, params, q_guess, fixed, 0.0, inputs, iterations, throw=False)
+    camber, toe = wheel_angles(system, params, q)
+    wc = q[:3]
+    residual = jnp.max(jnp.abs(constraints(system, params, q, jnp.reshape(rack, (1,)))))
+    return q, {"camber": camber, "toe": toe, "wheel_centre": wc, "track": 2.0 * wc[1], "residual": residual}
+
+
+# ---------------------------------------------------------------------------------------
+# Flexible pendulum (section 5.4.2)
+# ---------------------------------------------------------------------------------------
+
+
+def flexible_beam(length=1.0, n_modes=2, diameter=0.012, thickness=0.001, beta=0.0, n_elements=10):
+    """A free-free straight steel tube from the FE module (:func:`jaxveh.fe.straight_beam_body`),
+    origin at its ``start`` end, x along the tube; beta is stiffness-proportional damping (s)."""
+    from ..fe import straight_beam_body
+
+    return straight_beam_body(length, n_modes, n_elements, diameter, thickness, beta)
+
+
+def flexible_pendulum(modal=None, coupling=1.0, pinned: bool = True, gravity=9.81) -> tuple[System, SystemParams]:
+    """A flexible beam (modal body, floating frame) swinging in the x-z plane.
+
+    ``pinned``: the beam's ``start`` point is held on the ground origin by a revolute joint
+    about y (independent velocities ``beam.wy`` and every modal velocity); otherwise the beam
+    floats freely (all six rigid and the modal velocities independent). Rotation sequence
+    ``"zxy"`` so that the swing angle (about y) is the innermost, unbounded angle.
+    """
+    modal = flexible_beam() if modal is None else modal
+    b = SystemBuilder(gravity=(0.0, 0.0, -gravity))
+    b.add_flexible_body("beam", modal, coupling=coupling, rotation="zxy")
+    b.add_modal_point("start", "beam", "start")
+    b.add_modal_point("end", "beam", "end")
+    if pinned:
+        b.add_point("pivot", "ground", (0.0, 0.0, 0.0))
+        b.add_revolute("pin", "pivot", "start", axis_i=(0.0, 1.0, 0.0))
+        b.add_independent("beam", "wy")
+    else:
+        for name in ("ux", "uy", "uz", "wx", "wy", "wz"):
+            b.add_independent("beam", name)
+    for k in range(modal.n_modes):
+        b.add_independent("beam", f"p{k}_dot")
+    return b.build()
+
+
+def flexible_pendulum_state(system: System, angle=0.0, p0=None):
+    """``(q, z)``: beam start at the origin, swing angle ``angle`` (rad, about y, 0 =
+    horizontal along +x), modal coordinates ``p0``, at rest."""
+    nm = system.n_modes[0]
+    p = jnp.zeros((nm,)) if p0 is None else jnp.asarray(p0, jnp.float64)
+    q = jnp.concatenate([jnp.zeros((5,)), jnp.reshape(jnp.asarray(angle, jnp.float64), (1,)), p])
+    return q, jnp.zeros((system.n_dof,))
+
+
+# ---------------------------------------------------------------------------------------
+# Inspection (the thesis's "symbolic inspection" of M, Qi, R, done numerically)
+# ---------------------------------------------------------------------------------------
+
+#: Examples known to :func:`inspect_example`, with the meaning of their ``q`` / ``qdot``.
+EXAMPLES = {
+    "double-pendulum": ("theta1 (rad, absolute), theta2 (rad, relative)", "theta1_dot, theta2_dot (rad/s)"),
+    "four-bar": ("crank angle (rad, from +y)", "crank rate (rad/s)"),
+    "quarter-car": ("bump travel (m), rack travel (m)", "bump rate (m/s), wheel spin rate (rad/s)"),
+    "flexible-pendulum": ("swing angle (rad), modal coordinates p0, p1", "swing rate (rad/s), modal rates"),
+}
+_DEFAULT_Q = {
+    "double-pendulum": ((0.0, 0.0), (0.0, 0.0)),
+    "four-bar": ((0.7,), (0.0,)),
+    "quarter-car": ((0.0, 0.0), (0.0, 0.0)),
+    "flexible-pendulum": ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
+}
+
+
+def _example_state(name, q, qdot, values):
+    """``(system, params, q_full, z, inputs, param_values)`` for an example at (q, qdot)."""
+    from ..params import ParameterError
+
+    if name == "double-pendulum":
+        unknown = sorted(set(values) - set(DOUBLE_PENDULUM_DEFAULTS))
+        if unknown:
+            raise ParameterError(f"unknown --param {unknown}; allowed {sorted(DOUBLE_PENDULUM_DEFAULTS)}")
+        v = {**DOUBLE_PENDULUM_DEFAULTS, **values}
+        for k in ("m1", "m2", "l1"):
+            if not v[k] > 0.0:
+                raise ParameterError(f"--param {k}={v[k]:g} must be > 0")
+        for k in ("J1", "J2"):
+            if not v[k] >= 0.0:
+                raise ParameterError(f"--param {k}={v[k]:g} must be >= 0")
+        system, params = double_pendulum(v)
+        qf, z = double_pendulum_state(system, params, q, qdot)
+        return system, params, qf, z, None, v
+    if name == "four-bar":
+        unknown = sorted(set(values) - set(FOUR_BAR_DEFAULTS))
+        if unknown:
+            raise ParameterError(f"unknown --param {unknown}; allowed {sorted(FOUR_BAR_DEFAULTS)}")
+        v = {**FOUR_BAR_DEFAULTS, **values}
+        system, params = four_bar(v)
+        coupler, rocker = four_bar_angles(q[0], v)
+        qf = jnp.asarray([q[0], coupler - q[0], rocker])
+        return system, params, qf, jnp.asarray(qdot, jnp.float64), None, v
+    if values:
+        raise ParameterError(f"example {name!r} takes no --param")
+    if name == "quarter-car":
+        system, params = quarter_car()
+        qf, _ = quarter_car_kinematics(system, params, q[0], q[1])
+        rack = jnp.asarray(q[1], jnp.float64)
+        inputs = lambda t: jnp.reshape(rack, (1,))  # noqa: E731
+        return system, params, qf, jnp.asarray(qdot, jnp.float64), inputs, {}
+    system, params = flexible_pendulum()
+    qf, _ = flexible_pendulum_state(system, q[0], q[1:])
+    return system, params, qf, jnp.asarray(qdot, jnp.float64), None, {}
+
+
+def inspect_example(name: str, q=None, qdot=None, values: dict | None = None) -> dict:
+    """Reduced mass matrix, reduced internal and external forces and ``R`` of a built-in
+    example at independent positions ``q`` and velocities ``qdot`` (see :data:`EXAMPLES`).
+
+    ``internal_forces``: gyroscopic / Coriolis / centrifugal / elastic / damping forces
+    reduced to the independent velocities, ``R^T T^T (Q_v + Q_e - M (T_dot y + T S c))``;
+    ``external_forces``: gravity (and applied loads) reduced, ``R^T T^T Q_ext``. For the
+    double pendulum these are the ``M``, ``Qi``, ``Qe`` printed in thesis section 5.7.
+    """
+    from ..params import ParameterError
+    from ._projection import dynamics
+
+    if name not in EXAMPLES:
+        raise ParameterError(f"unknown example {name!r}; choose one of {sorted(EXAMPLES)}")
+    dq, dqd = _DEFAULT_Q[name]
+    q = tuple(dq) if q is None else tuple(float(x) for x in q)
+    qdot = tuple(dqd) if qdot is None else tuple(float(x) for x in qdot)
+    if len(q) != len(dq):
+        raise ParameterError(f"--q for {name} takes {len(dq)} values: {EXAMPLES[name][0]}; got {len(q)}")
+    if len(qdot) != len(dqd):
+        raise ParameterError(f"--qdot for {name} takes {len(dqd)} values: {EXAMPLES[name][1]}; got {len(qdot)}")
+    system, params, qf, z, inputs, used = _example_state(name, q, qdot, dict(values or {}))
+    dyn = dynamics(system, params, qf, z, 0.0, inputs)
+    return {
+        "example": name,
+        "q": list(q),
+        "qdot": list(qdot),
+        "independent_velocities": [system.y_names[k] for k in system.independent],
+        "mass_matrix": np.asarray(dyn.mass_matrix).tolist(),
+        "internal_forces": np.asarray(dyn.internal_forces).tolist(),
+        "external_forces": np.asarray(dyn.external_forces).tolist(),
+        "R": np.asarray(dyn.projection.R).tolist(),
+        "joint_velocity_names": list(system.y_names),
+        "constraint_residual": float(np.max(np.abs(np.asarray(dyn.projection.phi)), initial=0.0)),
+        "params": {k: float(v) for k, v in used.items()},
+    }
