@@ -14,6 +14,8 @@ from ._analytic import app as analytic_app  # noqa: E402
 app.add_typer(analytic_app, name="analytic")
 from ._tyre import app as tyre_app  # noqa: E402
 app.add_typer(tyre_app, name="tyre")
+from ._multibody import app as multibody_app  # noqa: E402
+app.add_typer(multibody_app, name="multibody")
 
 
 def main() -> None:
