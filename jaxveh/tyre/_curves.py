@@ -70,10 +70,15 @@ def combined_slip_curves(
     a = np.deg2rad(np.asarray(alphas_deg, dtype=np.float64))
     a = jnp.asarray(np.concatenate([-a[::-1], a]))
     kappa = jnp.linspace(-kappa_max, kappa_max, n)
-    fzs = jnp.full((a.shape[0],), fz, dtype=jnp.float64)
-    point = lambda f, al, k: tyre_forces(tyre, f, k, al, 0.0, tyre.longvl)  # noqa: E731
-    grid = jax.jit(jax.vmap(jax.vmap(point, in_axes=(None, None, 0)), in_axes=(0, 0, None)))(fzs, a, kappa)
+    grid = _combined(tyre, jnp.asarray(fz, dtype=jnp.float64), a, kappa)
     return a, kappa, grid.fx, grid.fy
+
+
+@eqx.filter_jit
+def _combined(tyre, fz, alphas, kappa):
+    """Forces on a grid: slip angles (n_a,) x kappa (n,), one load, camber 0."""
+    point = lambda al, k: tyre_forces(tyre, fz, k, al, 0.0, tyre.longvl)  # noqa: E731
+    return jax.vmap(jax.vmap(point, in_axes=(None, 0)), in_axes=(0, None))(alphas, kappa)
 
 
 def peak_table(tyre: MagicFormulaTyre, loads=FIG_B1_LOADS, n: int = 3001) -> list[dict[str, float]]:

@@ -138,14 +138,14 @@ def read_tyre_csv(path: str | Path) -> TyreMeasurements:
     return TyreMeasurements(*(jnp.asarray(cols[c]) for c in REQUIRED_COLUMNS), jnp.asarray(vx))
 
 
-def _with(tyre: MagicFormulaTyre, names: tuple[str, ...], values: dict) -> MagicFormulaTyre:
-    return eqx.tree_at(lambda t: [getattr(t, n) for n in names], tyre, [values[n] for n in names])
+def _with(tyre: MagicFormulaTyre, names: tuple[str, ...], values: Float[Array, "k"]) -> MagicFormulaTyre:
+    """``tyre`` with the coefficients ``names`` replaced by the entries of ``values``."""
+    return eqx.tree_at(lambda t: [getattr(t, n) for n in names], tyre, [values[i] for i in range(len(names))])
 
 
 def _residuals(tyre: MagicFormulaTyre, data: TyreMeasurements, outputs: tuple[str, ...]) -> Float[Array, "m"]:
     """Model minus measurement, forces over Fz and Mz over Fz R0 (dimensionless)."""
-    vx = jnp.where(jnp.isnan(data.vx), tyre.longvl, data.vx)
-    model = jax.vmap(tyre_forces, in_axes=(None, 0, 0, 0, 0, 0))(tyre, data.fz, data.kappa, data.alpha, data.gamma, vx)
+    model = _predict(tyre, data)
     scale = jnp.maximum(jnp.abs(data.fz), 1e-3 * tyre.fnomin)
     parts = []
     for out in outputs:
@@ -156,7 +156,7 @@ def _residuals(tyre: MagicFormulaTyre, data: TyreMeasurements, outputs: tuple[st
 
 @eqx.filter_jit
 def _solve(tyre, names, data, outputs, rtol, atol, max_steps):
-    y0 = {n: getattr(tyre, n) for n in names}
+    y0 = jnp.stack([getattr(tyre, n) for n in names])
     fn = lambda y, _: _residuals(_with(tyre, names, y), data, outputs)  # noqa: E731
     sol = optx.least_squares(fn, optx.LevenbergMarquardt(rtol=rtol, atol=atol), y0, max_steps=max_steps, throw=False)
     return sol.value, sol.result == optx.RESULTS.successful, sol.stats["num_steps"]
@@ -219,10 +219,18 @@ def fit_tir(
     return FitReport(tyre, tuple(report))
 
 
+def _predict(tyre: MagicFormulaTyre, data: TyreMeasurements):
+    """Model forces at the measured operating points (missing speed: LONGVL)."""
+    vx = jnp.where(jnp.isnan(data.vx), tyre.longvl, data.vx)
+    return jax.vmap(tyre_forces, in_axes=(None, 0, 0, 0, 0, 0))(tyre, data.fz, data.kappa, data.alpha, data.gamma, vx)
+
+
+_predict_jit = eqx.filter_jit(_predict)
+
+
 def _rms(tyre: MagicFormulaTyre, data: TyreMeasurements, outputs: tuple[str, ...]) -> dict[str, float]:
     """RMS error per output [N or Nm]."""
-    vx = jnp.where(jnp.isnan(data.vx), tyre.longvl, data.vx)
-    model = jax.vmap(tyre_forces, in_axes=(None, 0, 0, 0, 0, 0))(tyre, data.fz, data.kappa, data.alpha, data.gamma, vx)
+    model = _predict_jit(tyre, data)
     return {o: float(jnp.sqrt(jnp.mean((getattr(model, o) - getattr(data, o)) ** 2))) for o in outputs}
 
 
