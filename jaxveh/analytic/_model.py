@@ -113,9 +113,9 @@ RIGID_ROLL_MAP = jnp.asarray([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0],
 def accelerations(mass: Float[Array, "4 4"], forces: Float[Array, "4"], variant: Variant) -> Float[Array, "4"]:
     """dv/dt from ``M dv/dt = f``; for a rigid chassis, the projection on φF = φR."""
     if variant.flexible_roll:
-        return jnp.linalg.solve(mass, forces)
+        return jnp.linalg.solve(mass, forces[:, None])[:, 0]
     t = RIGID_ROLL_MAP
-    return t @ jnp.linalg.solve(t.T @ mass @ t, t.T @ forces)
+    return t @ jnp.linalg.solve(t.T @ mass @ t, (t.T @ forces)[:, None])[:, 0]
 
 
 def vector_field(vehicle: AnalyticVehicle, state, speed, delta, variant: Variant) -> Float[Array, "9"]:
