@@ -1,0 +1,187 @@
+"""Named design variables, bounded reparametrisation, and an Optax augmented-Lagrangian solver.
+
+A design variable is a leaf of the parameter pytree named by its attribute path
+(``"kC"``, ``"tyre.scale_rear"``) or, when the problem supplies ``apply``, any label the
+``apply`` function understands (``"lam"`` for the roll stiffness proportion). Each variable
+lives in ``[lower, upper]`` through a logistic map of an unconstrained variable (in log space
+with ``log=True``), so every Optax step stays feasible for the bounds.
+
+Constraints are scalar functions ``g(params) <= 0`` handled by the Powell-Hestenes-
+Rockafellar augmented Lagrangian: outer multiplier updates around ``inner_steps`` Optax
+steps.
+"""
+
+from typing import Callable, NamedTuple, Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+
+
+class Variable(NamedTuple):
+    """A bounded design variable: ``name`` (leaf path or label), bounds, optional log scale."""
+
+    name: str
+    lower: float
+    upper: float
+    log: bool = False
+
+
+def get_leaf(params, path: str):
+    """Leaf of ``params`` at dotted attribute ``path``; ``ValueError`` if it does not exist."""
+    node = params
+    for part in path.split("."):
+        if not hasattr(node, part):
+            raise ValueError(f"parameter path {path!r}: {type(node).__name__} has no field {part!r}")
+        node = getattr(node, part)
+    return node
+
+
+def set_leaves(params, values: dict):
+    """Copy of ``params`` with the leaves at the dotted paths of ``values`` replaced."""
+    for path, value in values.items():
+        get_leaf(params, path)
+        params = eqx.tree_at(lambda p, path=path: get_leaf(p, path), params, jnp.asarray(value, dtype=jnp.float64))
+    return params
+
+
+def target(fn: Callable, value: float, scale: float = 1.0) -> Callable:
+    """Objective ``((fn(params) - value)/scale)^2`` that drives ``fn`` to ``value``."""
+    return lambda params: ((fn(params) - value) / scale) ** 2
+
+
+class Problem(eqx.Module):
+    """``minimise objective(params)`` subject to ``constraint(params) <= 0`` for each constraint.
+
+    Attributes:
+        params: base parameter pytree (e.g. an ``AnalyticVehicle``).
+        variables: the design variables.
+        objective: scalar function of the parameter pytree.
+        constraints: scalar functions of the parameter pytree, feasible when <= 0.
+        apply: ``apply(params, {name: value}) -> params``; default :func:`set_leaves`.
+    """
+
+    params: object
+    variables: tuple[Variable, ...] = eqx.field(static=True)
+    objective: Callable = eqx.field(static=True)
+    constraints: tuple[Callable, ...] = eqx.field(static=True, default=())
+    apply: Optional[Callable] = eqx.field(static=True, default=None)
+
+    def __check_init__(self):
+        for var in self.variables:
+            if not var.lower < var.upper:
+                raise ValueError(f"variable {var.name!r}: need lower < upper, got [{var.lower}, {var.upper}]")
+            if var.log and var.lower <= 0.0:
+                raise ValueError(f"variable {var.name!r}: log scale needs lower > 0, got {var.lower}")
+
+    def to_values(self, z) -> dict:
+        """Unconstrained vector ``z`` -> ``{name: value}`` inside the bounds."""
+        out = {}
+        for i, var in enumerate(self.variables):
+            s = jax.nn.sigmoid(z[i])
+            if var.log:
+                out[var.name] = jnp.exp(jnp.log(var.lower) + s * (jnp.log(var.upper) - jnp.log(var.lower)))
+            else:
+                out[var.name] = var.lower + s * (var.upper - var.lower)
+        return out
+
+    def to_z(self, values: dict):
+        """Inverse of :meth:`to_values` (values must lie strictly inside the bounds)."""
+        zs = []
+        for var in self.variables:
+            x = float(values[var.name])
+            if not var.lower < x < var.upper:
+                raise ValueError(f"initial {var.name} = {x} must lie strictly inside ({var.lower}, {var.upper})")
+            s = (np.log(x) - np.log(var.lower)) / (np.log(var.upper) - np.log(var.lower)) if var.log else (x - var.lower) / (var.upper - var.lower)
+            zs.append(np.log(s / (1.0 - s)))
+        return jnp.asarray(zs)
+
+    def build(self, z):
+        """Parameter pytree at unconstrained design ``z``."""
+        apply = self.apply if self.apply is not None else set_leaves
+        return apply(self.params, self.to_values(z))
+
+
+class Result(NamedTuple):
+    """Solution: variable values, parameter pytree, objective, constraint values, history."""
+
+    values: dict
+    params: object
+    objective: float
+    constraints: list
+    history: list
+
+
+def _lagrangian(problem: Problem, z, multipliers, rho):
+    params = problem.build(z)
+    value = problem.objective(params)
+    for k, g in enumerate(problem.constraints):
+        c = g(params)
+        value = value + (jnp.maximum(0.0, multipliers[k] + rho * c) ** 2 - multipliers[k] ** 2) / (2.0 * rho)
+    return value
+
+
+def solve(
+    problem: Problem,
+    initial: dict,
+    optimiser: optax.GradientTransformation | None = None,
+    inner_steps: int = 300,
+    outer_steps: int = 10,
+    rho: float = 10.0,
+    rho_growth: float = 4.0,
+    constraint_tol: float = 1e-6,
+) -> Result:
+    """Minimise ``problem`` from ``initial`` values with Optax (default Adam, lr 0.05).
+
+    Each outer iteration runs ``inner_steps`` optimiser steps on the augmented Lagrangian
+    (one compiled ``lax.scan``), then updates multipliers and grows the penalty while the
+    worst constraint violation exceeds ``constraint_tol``. Raises ``RuntimeError`` if the
+    objective or gradient becomes non-finite.
+    """
+    optimiser = optax.adam(0.05) if optimiser is None else optimiser
+    z = problem.to_z(initial)
+    n_con = len(problem.constraints)
+    multipliers = jnp.zeros(n_con)
+
+    @eqx.filter_jit
+    def inner(z, multipliers, rho):
+        grad_fn = jax.value_and_grad(lambda zz: _lagrangian(problem, zz, multipliers, rho))
+
+        def step(carry, _):
+            z, state = carry
+            value, grad = grad_fn(z)
+            # Optax mixes int32 step counts with floats; allow it even under strict promotion.
+            with jax.numpy_dtype_promotion("standard"):
+                updates, state = optimiser.update(grad, state, z)
+            return (optax.apply_updates(z, updates), state), value
+
+        with jax.numpy_dtype_promotion("standard"):
+            state = optimiser.init(z)
+        (z, _), values = jax.lax.scan(step, (z, state), None, length=inner_steps)
+        return z, values
+
+    @eqx.filter_jit
+    def evaluate(z):
+        params = problem.build(z)
+        return problem.objective(params), jnp.stack([g(params) for g in problem.constraints]) if n_con else jnp.zeros(0)
+
+    history = []
+    rho = jnp.asarray(rho, dtype=jnp.float64)
+    for _ in range(outer_steps):
+        z, values = inner(z, multipliers, rho)
+        if not bool(jnp.all(jnp.isfinite(values))) or not bool(jnp.all(jnp.isfinite(z))):
+            raise RuntimeError("optimisation produced a non-finite objective or design; check bounds and the objective")
+        obj, cons = evaluate(z)
+        history.append({"objective": float(obj), "max_violation": float(jnp.max(cons, initial=0.0)), **{k: float(v) for k, v in problem.to_values(z).items()}})
+        if n_con == 0:
+            break
+        multipliers = jnp.maximum(0.0, multipliers + rho * cons)
+        if float(jnp.max(cons, initial=0.0)) > constraint_tol:
+            rho = rho * rho_growth
+        elif len(history) > 1 and abs(history[-1]["objective"] - history[-2]["objective"]) <= 1e-9 * max(1.0, abs(history[-1]["objective"])):
+            break
+    obj, cons = evaluate(z)
+    values = {k: float(v) for k, v in problem.to_values(z).items()}
+    return Result(values=values, params=problem.build(z), objective=float(obj), constraints=[float(c) for c in cons], history=history)
