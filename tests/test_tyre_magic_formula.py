@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import jaxveh.tyre as jt
+from jaxveh.params import as_float
 from helpers import central_difference
 
 FSAE = jt.load_fsae_tyre()
@@ -246,7 +247,7 @@ def test_no_retrace_when_values_change():
         return jt.tyre_forces(tyre, fz, 0.05, 0.05, 0.0, 11.0).fy
 
     run(FSAE, jnp.asarray(500.0))
-    run(eqx.tree_at(lambda t: t.pky1, FSAE, jnp.asarray(-35.0)), jnp.asarray(800.0))
+    run(eqx.tree_at(lambda t: t.pky1, FSAE, as_float(-35.0)), jnp.asarray(800.0))  # as_float: not weak-typed
 
 
 def test_scalar_outputs_and_dtypes():
