@@ -18,6 +18,7 @@ import numpy as np
 import optimistix as optx
 from jaxtyping import Array, Float
 
+from .._config import check_x64
 from ..params import ParameterError
 from ._magic_formula import tyre_forces
 from ._model import MagicFormulaTyre
@@ -193,6 +194,7 @@ def fit_tir(
         :class:`FitReport` with the fitted tyre and, per stage, the rows used, RMS
         residuals before and after [N, Nm], steps taken and whether it converged.
     """
+    check_x64()
     if start is None:
         from ._tir import load_fsae_tyre
 

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._config import check_x64
 from ..params import ParameterError
 from ._model import SUPPORTED_FITTYP, MagicFormulaTyre, coefficient_fields
 
@@ -89,6 +90,7 @@ def parse_tir(text: str, source: str = "<tir>") -> MagicFormulaTyre:
         TirError: malformed line, non-numeric value, duplicate or missing required key,
             non-SI ``[UNITS]``, or a FITTYP outside the MF 5.x family.
     """
+    check_x64()
     fields = {f.name.upper(): f for f in coefficient_fields()}
     values: dict[str, float] = {}
     extras: list[tuple[str, str, str]] = []
