@@ -92,7 +92,7 @@ def _np_fy0(t, fz, alpha, gamma):
     c = g["pcy1"] * g["lcy"]
     d = (g["pdy1"] + g["pdy2"] * dfz) * (1 - g["pdy3"] * gy**2) * g["lmuy"] * fz
     e = min((g["pey1"] + g["pey2"] * dfz) * (1 - (g["pey3"] + g["pey4"] * gy) * np.sign(ay)) * g["ley"], 1.0)
-    k = g["pky1"] * fz0 * np.sin(2 * np.arctan(fz / (g["pky2"] * fz0 * g["lfzo"]))) * (1 - g["pky3"] * abs(gy)) * g["lfzo"] * g["lky"]
+    k = g["pky1"] * g["fnomin"] * np.sin(2 * np.arctan(fz / (g["pky2"] * fz0))) * (1 - g["pky3"] * abs(gy)) * g["lfzo"] * g["lky"]
     b = k / (c * d)
     sv = fz * ((g["pvy1"] + g["pvy2"] * dfz) * g["lvy"] + (g["pvy3"] + g["pvy4"] * dfz) * gy) * g["lmuy"]
     return d * np.sin(c * np.arctan(b * ay - e * (b * ay - np.arctan(b * ay)))) + sv
@@ -100,7 +100,6 @@ def _np_fy0(t, fz, alpha, gamma):
 
 def test_pure_lateral_matches_independent_numpy():
     for fz, a, g in [(3500.0, 0.05, 0.0), (2000.0, -0.12, 0.03), (5000.0, 0.3, -0.05)]:
-        # the fixture has LFZO = 1, so the two K_y forms agree
         np.testing.assert_allclose(float(FORCES(FIXTURE, *_pt(fz, 0.0, a, g, 20.0)).fy), _np_fy0(FIXTURE, fz, a, g), rtol=1e-12)
 
 

@@ -167,12 +167,12 @@ def tyre_forces(
 
     # combined Fx
     bxa = t.rbx1 * jnp.cos(jnp.arctan(t.rbx2 * kappa)) * t.lxal
-    gxa = _weight(bxa, t.rcx1, t.rex1 + t.rex2 * dfz, alpha, t.rhx1)
+    gxa = _weight(bxa, t.rcx1, jnp.minimum(t.rex1 + t.rex2 * dfz, 1.0), alpha, t.rhx1)
     fx = gxa * fx0
 
     # combined Fy with kappa-induced side force
     byk = t.rby1 * jnp.cos(jnp.arctan(t.rby2 * (alpha - t.rby3))) * t.lyka
-    gyk = _weight(byk, t.rcy1, t.rey1 + t.rey2 * dfz, kappa, t.rhy1 + t.rhy2 * dfz)
+    gyk = _weight(byk, t.rcy1, jnp.minimum(t.rey1 + t.rey2 * dfz, 1.0), kappa, t.rhy1 + t.rhy2 * dfz)
     dvyk = muy * fz * (t.rvy1 + t.rvy2 * dfz + t.rvy3 * gamma) * jnp.cos(jnp.arctan(t.rvy4 * alpha))
     svyk = dvyk * jnp.sin(t.rvy5 * jnp.arctan(t.rvy6 * kappa)) * t.lvyka
     fy = gyk * fy0 + svyk
