@@ -43,6 +43,7 @@ from ._kinematics import (
 from ._projection import (
     Dynamics as Dynamics,
     Projection as Projection,
+    check_mass_matrix as check_mass_matrix,
     check_rank as check_rank,
     dynamics as dynamics,
     input_values as input_values,

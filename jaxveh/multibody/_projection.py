@@ -19,7 +19,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from ._dynamics import internal_forces, mass_matrix
-from ._errors import RedundantConstraintError
+from ._errors import RedundantConstraintError, SingularMassMatrixError
 from ._kinematics import constraints, velocity_maps
 from ._system import System, SystemParams
 
@@ -65,15 +65,21 @@ class Projection(eqx.Module):
     lu: tuple
 
 
+def _jacobians(system, params, q, t, inputs):
+    """``Phi``, ``Phi_t``, ``Phi_q``, ``T`` and ``B T`` at ``(q, t)``."""
+    phi_fn = _phi_of(system, params, inputs)
+    phi, phi_t = jax.jvp(lambda tt: phi_fn(q, tt), (t,), (jnp.ones_like(t),))
+    phi_q = jax.jacfwd(phi_fn)(q, t)
+    t_mat, bt = jax.jacfwd(lambda y: velocity_maps(system, params, q, y))(jnp.zeros((system.n_y,), q.dtype))
+    return phi, phi_t, phi_q, t_mat, bt
+
+
 def projection(
     system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, kappa=0.0
 ) -> Projection:
     """Constraint Jacobians, ``T``, ``B T`` and the projection ``R``, ``S b`` (eq. 5.54)."""
     t = jnp.asarray(t, q.dtype)
-    phi_fn = _phi_of(system, params, inputs)
-    phi, phi_t = jax.jvp(lambda tt: phi_fn(q, tt), (t,), (jnp.ones_like(t),))
-    phi_q = jax.jacfwd(phi_fn)(q, t)
-    t_mat, bt = jax.jacfwd(lambda y: velocity_maps(system, params, q, y))(jnp.zeros((system.n_y,), q.dtype))
+    phi, phi_t, phi_q, t_mat, bt = _jacobians(system, params, q, t, inputs)
     m, ndof = system.n_constraints, system.n_dof
     a = jnp.concatenate([phi_q @ bt, _selection(system, q.dtype)])
     lu = jax.scipy.linalg.lu_factor(a)
@@ -198,8 +204,9 @@ def multipliers(system: System, dyn: Dynamics) -> Float[Array, " m"]:
 def check_rank(system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, tol=1e-9) -> None:
     """Raise :class:`RedundantConstraintError` naming the joints or velocities at fault when
     ``[Phi_q B T; P]`` loses rank at ``q`` (Python-level check on concrete values)."""
-    proj = projection(system, params, jnp.asarray(q), t, inputs)
-    phi_y = np.asarray(proj.phi_q @ proj.BT)
+    q = jnp.asarray(q, jnp.float64)
+    _, _, phi_q, _, bt = _jacobians(system, params, q, jnp.asarray(t, q.dtype), inputs)
+    phi_y = np.asarray(phi_q @ bt)
     names_c, names_y = system.constraint_names, system.y_names
     if phi_y.shape[0] > 0:
         u, s, _ = np.linalg.svd(phi_y)
@@ -221,4 +228,21 @@ def check_rank(system: System, params: SystemParams, q, t=0.0, inputs: Inputs | 
         raise RedundantConstraintError(
             f"independent velocities {chosen} are dependent at this configuration: the joint "
             f"velocities {moving} can move with all of them held at zero; declare another set"
+        )
+
+
+def check_mass_matrix(system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, tol=1e-12):
+    """Raise :class:`SingularMassMatrixError` when the reduced mass matrix ``R^T T^T M T R``
+    at ``q`` is singular or indefinite, naming the independent velocities involved."""
+    check_rank(system, params, q, t, inputs)
+    q = jnp.asarray(q, jnp.float64)
+    proj = projection(system, params, q, t, inputs)
+    tr = proj.T @ proj.R
+    m_red = np.asarray(tr.T @ mass_matrix(system, params, q) @ tr)
+    w, vecs = np.linalg.eigh(m_red)
+    if w[0] <= tol * max(abs(w[-1]), 1.0):
+        names = [system.y_names[system.independent[k]] for k in np.flatnonzero(np.abs(vecs[:, 0]) > 0.1)]
+        raise SingularMassMatrixError(
+            f"reduced mass matrix is singular (smallest eigenvalue {w[0]:.3e}); the independent "
+            f"velocities {names} carry no inertia: give the bodies they move mass or inertia"
         )

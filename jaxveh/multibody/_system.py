@@ -397,7 +397,9 @@ class SystemBuilder:
         if len(indep) != n_dof:
             raise ValueError(
                 f"{len(indep)} independent velocities declared, but {system.n_y} joint velocities minus "
-                f"{system.n_constraints} constraint equations leave {n_dof}"
+                f"{system.n_constraints} constraint equations leave {n_dof}; if the mechanism really has "
+                f"{len(indep)} degrees of freedom, {len(indep) - n_dof} constraint equation(s) are redundant "
+                "(remove them, or impose fewer spherical components)"
             )
         system = dataclasses.replace(system, independent=tuple(indep))
         params = SystemParams(
