@@ -48,7 +48,7 @@ def understeer_report(vehicle: AnalyticVehicle) -> dict:
 def skidpad_report(vehicle: AnalyticVehicle, variants=tuple(VARIANTS), radius=50.0, ay_max_g=1.3, n=27) -> dict:
     """δd (deg) and 1/ku (g/deg) versus ay (g) on a circle of ``radius`` m (Figs. 3.6, 3.7).
 
-    Only converged steady states are reported; ``ay_limit_g`` is the highest converged ay.
+    Only converged, stable steady states are reported; ``ay_limit_g`` is the highest one.
     """
     _positive("radius", radius)
     _positive("ay_max_g", ay_max_g)
@@ -56,7 +56,7 @@ def skidpad_report(vehicle: AnalyticVehicle, variants=tuple(VARIANTS), radius=50
     out = {"radius_m": radius, "variants": {}}
     for name in variants:
         state, sens = skidpad_sweep(vehicle, ay, VARIANTS[name], radius)
-        ok = np.asarray(state.converged)
+        ok = np.asarray(state.converged) & np.asarray(state.stable)
         out["variants"][name] = {
             "ay_g": (ay[ok] / GRAVITY).tolist(),
             "delta_dynamic_deg": np.degrees(np.asarray(state.delta_dynamic)[ok]).tolist(),

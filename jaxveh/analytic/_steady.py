@@ -14,9 +14,12 @@ import optimistix as optx
 from jaxtyping import Array, Float
 
 from ..params import AnalyticVehicle
-from ._model import N_STATES, PHIF, PHIR, R, V, Variant, generalised_forces
+from ._model import N_STATES, PF, PHIF, PHIR, PR, R, V, Variant, generalised_forces, vector_field
 from ._roll_steer import understeer_gradient, understeer_gradient_rigid
 from ._quantities import roll_gradient
+
+#: [v, r, pF, pR, phiF, phiR] = E @ [v, r, p, phi] for the rigid chassis.
+_RIGID_EMBEDDING = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0, 0, 0, 1))
 
 #: Newton tolerances on the unknowns (m/s and rad): far below any plotted resolution.
 NEWTON_RTOL = 1e-10
@@ -38,6 +41,7 @@ class SteadyState(eqx.Module):
     phi_front: Float[Array, ""]
     phi_rear: Float[Array, ""]
     converged: Array
+    stable: Array
 
 
 def _state(w, r):
@@ -91,7 +95,28 @@ def skidpad_steady_state(vehicle: AnalyticVehicle, ay, variant: Variant, radius=
         phi_front=w[2],
         phi_rear=w[3],
         converged=converged,
+        stable=_is_stable(vehicle, w, speed, radius, variant),
     )
+
+
+def _is_stable(vehicle: AnalyticVehicle, w, speed, radius, variant: Variant) -> Array:
+    """Whether the trim is asymptotically stable at fixed steer (all eigenvalues Re < 0).
+
+    Beyond an axle's peak slip angle the steady-state equations keep having solutions,
+    but on an unstable branch: those are not reachable skid-pad states.
+    """
+    idx = jnp.asarray([V, R, PF, PR, PHIF, PHIR])
+    base = _state(w, speed / radius)
+
+    def f(x):
+        return vector_field(vehicle, base.at[idx].set(x), speed, w[1], variant)[idx]
+
+    jac = jax.jacfwd(f)(base[idx])
+    if not variant.flexible_roll:
+        # Restrict to φF = φR, pF = pR (the rigid projection leaves a neutral twist direction).
+        e = jnp.asarray(_RIGID_EMBEDDING)
+        jac = jnp.linalg.pinv(e) @ jac @ e
+    return jnp.all(jnp.real(jnp.linalg.eigvals(jac)) < 0.0)
 
 
 def steering_sensitivity(vehicle: AnalyticVehicle, ay, variant: Variant, radius=50.0) -> Float[Array, ""]:
@@ -113,8 +138,9 @@ def skidpad_sweep(vehicle: AnalyticVehicle, ay_values, variant: Variant, radius=
     """Steady states and steering sensitivities 1/ku (m/s^2 per rad) over an array of ay.
 
     One vmapped call. Points where Newton's method fails (ay above the grip limit) have
-    ``converged = False`` and NaN values: callers must select ``converged`` points (the
-    CLI and experiments do and report the highest converged ay).
+    ``converged = False`` and NaN values; points on the unstable branch beyond an axle's
+    force peak have ``stable = False``. Callers select ``converged & stable`` points (the
+    reports do, and give the highest such ay as the limit).
     """
     radius = jnp.asarray(radius, dtype=jnp.float64)
 
@@ -123,6 +149,7 @@ def skidpad_sweep(vehicle: AnalyticVehicle, ay_values, variant: Variant, radius=
         sens = _sensitivity_at(vehicle, state, variant, radius)
         nan = jnp.nan
         state = jax.tree.map(lambda x: jnp.where(state.converged, x, nan) if x.dtype == jnp.float64 else x, state)
+        state = eqx.tree_at(lambda s: s.stable, state, state.stable & state.converged)
         return state, jnp.where(state.converged, sens, nan)
 
     return jax.vmap(one)(jnp.asarray(ay_values, dtype=jnp.float64))

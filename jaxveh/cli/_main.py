@@ -12,10 +12,15 @@ app = typer.Typer(
 from ._analytic import app as analytic_app  # noqa: E402
 
 app.add_typer(analytic_app, name="analytic")
+from ._run import run as run_command  # noqa: E402
+
+app.command("run")(run_command)
 from ._tyre import app as tyre_app  # noqa: E402
 app.add_typer(tyre_app, name="tyre")
 from ._multibody import app as multibody_app  # noqa: E402
 app.add_typer(multibody_app, name="multibody")
+from ._chassis import app as chassis_app  # noqa: E402
+app.add_typer(chassis_app, name="chassis")
 
 
 def main() -> None:
