@@ -130,3 +130,13 @@ def test_axes_mapping_round_trip_and_signs():
     assert float(jt.tyre_forces(FSAE, 700.0, 0.0, 0.0, g_right, 11.0).fy) < 0.0
     # lift-off: no vertical pull
     assert float(jt.forces_to_vehicle(f, -10.0, 0.0)[0][2]) == 0.0
+
+
+def test_abstract_tyre_interface():
+    assert isinstance(FSAE, jt.AbstractTyre)
+    f = jax.jit(lambda t: t.forces(700.0, 0.05, 0.02, 0.0, 11.0))(FSAE)
+    ref = jt.tyre_forces(FSAE, 700.0, 0.05, 0.02, 0.0, 11.0)
+    np.testing.assert_allclose(list(f), list(ref), rtol=1e-14)
+    assert FSAE.relaxation_lengths(700.0, 0.0) == jt.relaxation_lengths(FSAE, 700.0, 0.0)
+    assert float(FSAE.vertical_force(0.002, 0.0)) == 300.0
+    assert float(FSAE.effective_rolling_radius(700.0)) == float(jt.effective_rolling_radius(FSAE, 700.0))

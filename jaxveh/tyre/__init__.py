@@ -10,6 +10,7 @@ from ._axes import (
     slip_velocities as slip_velocities,
     velocity_to_wheel as velocity_to_wheel,
 )
+from ._base import AbstractTyre as AbstractTyre, TyreForces as TyreForces
 from ._curves import (
     PureSlipCurves as PureSlipCurves,
     combined_slip_curves as combined_slip_curves,
@@ -25,7 +26,7 @@ from ._fit import (
     read_tyre_csv as read_tyre_csv,
     write_tyre_csv as write_tyre_csv,
 )
-from ._magic_formula import TyreForces as TyreForces, tyre_forces as tyre_forces
+from ._magic_formula import tyre_forces as tyre_forces
 from ._model import (
     SUPPORTED_FITTYP as SUPPORTED_FITTYP,
     MagicFormulaTyre as MagicFormulaTyre,

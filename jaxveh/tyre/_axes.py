@@ -18,7 +18,7 @@ only that yaw rotation, and the convention for camber:
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
-from ._magic_formula import TyreForces
+from ._base import TyreForces
 
 Scalar = Float[Array, ""]
 

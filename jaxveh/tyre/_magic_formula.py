@@ -29,12 +29,15 @@ Numerical treatment (all documented in ``docs/tyre.md``):
   dropped and the square root uses a safe double-``where`` at zero slip.
 """
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING
 
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
-from ._model import MagicFormulaTyre
+from ._base import TyreForces
+
+if TYPE_CHECKING:
+    from ._model import MagicFormulaTyre
 
 #: Below this fraction of the nominal load the forces scale linearly with load to zero.
 LIFTOFF_FRACTION = 0.01
@@ -48,16 +51,6 @@ LOAD_CLIP_FACTOR = 1.0e3
 SPEED_CLIP = 1.0e3
 
 Scalar = Float[Array, ""]
-
-
-class TyreForces(NamedTuple):
-    """Tyre forces [N] and moments [Nm] at the contact point, ISO-W axes."""
-
-    fx: Scalar
-    fy: Scalar
-    mx: Scalar
-    my: Scalar
-    mz: Scalar
 
 
 def _safe_div(num, den):
@@ -83,7 +76,7 @@ def _weight(b, c, e, x, shift):
     return _mf_cos(b, c, e, x + shift) / _mf_cos(b, c, e, shift)
 
 
-def _longitudinal(t: MagicFormulaTyre, fz, dfz, kappa, gamma):
+def _longitudinal(t: "MagicFormulaTyre", fz, dfz, kappa, gamma):
     """Pure-slip Fx0 and the longitudinal slip stiffness Kx [N]."""
     gx = gamma * t.lgax
     shx = (t.phx1 + t.phx2 * dfz) * t.lhx
@@ -99,7 +92,7 @@ def _longitudinal(t: MagicFormulaTyre, fz, dfz, kappa, gamma):
     return _mf(bx, cx, dx, ex, kx_) + svx, kxk
 
 
-def _lateral(t: MagicFormulaTyre, fz, fz0, dfz, alpha, gamma):
+def _lateral(t: "MagicFormulaTyre", fz, fz0, dfz, alpha, gamma):
     """Pure-slip Fy0 and the quantities Mz and combined Fy need."""
     gy = gamma * t.lgay
     shy = (t.phy1 + t.phy2 * dfz) * t.lhy + t.phy3 * gy
@@ -123,7 +116,7 @@ def _safe_sqrt(q):
 
 
 def tyre_forces(
-    tyre: MagicFormulaTyre,
+    tyre: "MagicFormulaTyre",
     fz: ArrayLike,
     kappa: ArrayLike,
     alpha: ArrayLike,

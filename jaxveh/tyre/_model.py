@@ -13,9 +13,13 @@ the MF 5.2 load-dependent forms (``PTX1``, ``PTY1``).
 import dataclasses
 
 import equinox as eqx
-from jaxtyping import Array, Float
+from jaxtyping import Array, ArrayLike, Float
 
 from ..params import float_field
+from ._base import AbstractTyre, TyreForces
+from ._magic_formula import tyre_forces
+from ._transient import relaxation_lengths
+from ._vertical import effective_rolling_radius, vertical_force
 
 #: Fit types of the MF 5.x family this model implements (MF-Tyre 5.0/5.1/5.2, PAC2002).
 SUPPORTED_FITTYP: tuple[int, ...] = (5, 6, 21)
@@ -37,7 +41,7 @@ _RO, _AL, _RL = "ROLLING_COEFFICIENTS", "ALIGNING_COEFFICIENTS", "RELAXATION_LEN
 Scalar = Float[Array, ""]
 
 
-class MagicFormulaTyre(eqx.Module):
+class MagicFormulaTyre(AbstractTyre):
     """Magic Formula 5.2 (PAC2002) coefficients, ISO-W sign convention, SI units.
 
     Build one with :func:`jaxveh.tyre.read_tir`, :func:`jaxveh.tyre.load_fsae_tyre`, or by
@@ -221,6 +225,22 @@ class MagicFormulaTyre(eqx.Module):
             )
         if self.relaxation_model not in RELAXATION_MODELS:
             raise ValueError(f"relaxation_model must be one of {RELAXATION_MODELS}, got {self.relaxation_model!r}")
+
+    def forces(self, fz: ArrayLike, kappa: ArrayLike, alpha: ArrayLike, gamma: ArrayLike, vx: ArrayLike) -> TyreForces:
+        """:func:`jaxveh.tyre.tyre_forces` of this tyre."""
+        return tyre_forces(self, fz, kappa, alpha, gamma, vx)
+
+    def relaxation_lengths(self, fz: ArrayLike, gamma: ArrayLike) -> tuple[Scalar, Scalar]:
+        """:func:`jaxveh.tyre.relaxation_lengths` of this tyre [m]."""
+        return relaxation_lengths(self, fz, gamma)
+
+    def vertical_force(self, deflection: ArrayLike, deflection_rate: ArrayLike) -> Scalar:
+        """:func:`jaxveh.tyre.vertical_force` of this tyre [N]."""
+        return vertical_force(self, deflection, deflection_rate)
+
+    def effective_rolling_radius(self, fz: ArrayLike) -> Scalar:
+        """:func:`jaxveh.tyre.effective_rolling_radius` of this tyre [m]."""
+        return effective_rolling_radius(self, fz)
 
 
 def coefficient_fields() -> tuple[dataclasses.Field, ...]:

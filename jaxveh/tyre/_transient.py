@@ -12,16 +12,20 @@ At constant speed the lagged slips tend to the steady ISO-W slips ``kappa = -Vsx
 integrate the slip velocity (a spring-like tyre), so nothing is singular at Vx = 0.
 """
 
+from typing import TYPE_CHECKING
+
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
 from ._magic_formula import LIFTOFF_FRACTION
-from ._model import MagicFormulaTyre
+
+if TYPE_CHECKING:
+    from ._model import MagicFormulaTyre
 
 Scalar = Float[Array, ""]
 
 
-def relaxation_lengths(tyre: MagicFormulaTyre, fz: ArrayLike, gamma: ArrayLike) -> tuple[Scalar, Scalar]:
+def relaxation_lengths(tyre: "MagicFormulaTyre", fz: ArrayLike, gamma: ArrayLike) -> tuple[Scalar, Scalar]:
     """Relaxation lengths ``(sigma_kappa, sigma_alpha)`` [m].
 
     ``relaxation_model == "constant"``: ``SIGMA_KAPPA * LSGKP``, ``SIGMA_ALPHA * LSGAL``
@@ -46,7 +50,7 @@ def relaxation_lengths(tyre: MagicFormulaTyre, fz: ArrayLike, gamma: ArrayLike) 
 
 
 def transient_slip_rhs(
-    tyre: MagicFormulaTyre,
+    tyre: "MagicFormulaTyre",
     deflection: Float[Array, "2"],
     fz: ArrayLike,
     gamma: ArrayLike,
@@ -72,7 +76,7 @@ def transient_slip_rhs(
 
 
 def transient_slips(
-    tyre: MagicFormulaTyre, deflection: Float[Array, "2"], fz: ArrayLike, gamma: ArrayLike
+    tyre: "MagicFormulaTyre", deflection: Float[Array, "2"], fz: ArrayLike, gamma: ArrayLike
 ) -> tuple[Scalar, Scalar]:
     """Lagged slips ``(kappa', alpha')`` to feed :func:`tyre_forces` (alpha in rad)."""
     sk, sa = relaxation_lengths(tyre, fz, gamma)
@@ -86,7 +90,7 @@ def low_speed_denominator(vx: ArrayLike, vxlow: ArrayLike) -> Scalar:
     return jnp.where(speed >= vxlow, speed, 0.5 * vxlow + vx**2 / (2.0 * vxlow))
 
 
-def steady_slips(tyre: MagicFormulaTyre, vx: ArrayLike, vsx: ArrayLike, vsy: ArrayLike) -> tuple[Scalar, Scalar]:
+def steady_slips(tyre: "MagicFormulaTyre", vx: ArrayLike, vsx: ArrayLike, vsy: ArrayLike) -> tuple[Scalar, Scalar]:
     """Steady-state ISO-W slips ``(kappa, alpha)`` from slip velocities.
 
     ``kappa = -vsx / V``, ``alpha = atan(vsy / V)`` with ``V = low_speed_denominator(vx,

@@ -4,15 +4,18 @@ Table B.4: vertical stiffness 150 kN/m, damping 50 Ns/m (the ``.tir`` keys
 ``VERTICAL_STIFFNESS`` and ``VERTICAL_DAMPING``).
 """
 
+from typing import TYPE_CHECKING
+
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
-from ._model import MagicFormulaTyre
+if TYPE_CHECKING:
+    from ._model import MagicFormulaTyre
 
 Scalar = Float[Array, ""]
 
 
-def vertical_force(tyre: MagicFormulaTyre, deflection: ArrayLike, deflection_rate: ArrayLike) -> Scalar:
+def vertical_force(tyre: "MagicFormulaTyre", deflection: ArrayLike, deflection_rate: ArrayLike) -> Scalar:
     """Normal load [N] of a point-contact tyre, positive in compression.
 
     ``Fz = max(kz * rho + cz * rho_dot, 0)``: the tyre pushes, never pulls, so it lifts off
@@ -32,13 +35,13 @@ def vertical_force(tyre: MagicFormulaTyre, deflection: ArrayLike, deflection_rat
     return jnp.maximum(tyre.vertical_stiffness * rho + tyre.vertical_damping * rho_dot, 0.0)
 
 
-def loaded_radius(tyre: MagicFormulaTyre, fz: ArrayLike) -> Scalar:
+def loaded_radius(tyre: "MagicFormulaTyre", fz: ArrayLike) -> Scalar:
     """Static loaded radius ``R0 - max(Fz, 0)/kz`` [m] of the linear vertical tyre."""
     fz = jnp.maximum(jnp.asarray(fz, dtype=jnp.float64), 0.0)
     return tyre.unloaded_radius - fz / tyre.vertical_stiffness
 
 
-def effective_rolling_radius(tyre: MagicFormulaTyre, fz: ArrayLike) -> Scalar:
+def effective_rolling_radius(tyre: "MagicFormulaTyre", fz: ArrayLike) -> Scalar:
     """MF 5.2 effective rolling radius ``Re`` [m] (forward speed / wheel spin rate).
 
     ``Re = R0 - rho_Fz0 * (DREFF * atan(BREFF * rho_d) + FREFF * rho_d)`` with
