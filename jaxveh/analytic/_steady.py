@@ -114,7 +114,7 @@ def _is_stable(vehicle: AnalyticVehicle, w, speed, radius, variant: Variant) -> 
     jac = jax.jacfwd(f)(base[idx])
     if not variant.flexible_roll:
         # Restrict to φF = φR, pF = pR (the rigid projection leaves a neutral twist direction).
-        e = jnp.asarray(_RIGID_EMBEDDING)
+        e = jnp.asarray(_RIGID_EMBEDDING, dtype=jnp.float64)
         jac = jnp.linalg.pinv(e) @ jac @ e
     return jnp.all(jnp.real(jnp.linalg.eigvals(jac)) < 0.0)
 
