@@ -61,7 +61,14 @@ def test_plot_writes_four_panels(tmp_path):
     for name in jt.PANEL_FILES:
         assert (tmp_path / name).stat().st_size > 10_000
     peaks = json.loads((tmp_path / "peaks.json").read_text())["peaks"]
-    assert [p["fz"] for p in peaks] == [250.0, 500.0, 750.0, 1000.0]
+    assert [p["fz"] for p in peaks] == pytest.approx([3500.0 / 3, 7000.0 / 3, 3500.0, 14000.0 / 3])  # FNOMIN x k/3
+
+
+def test_plot_loads_option(tmp_path):
+    res = RUNNER.invoke(app, ["tyre", "peaks", "--loads", "300,900", "--json"])
+    assert res.exit_code == 0 and [r["fz"] for r in json.loads(res.stdout)] == [300.0, 900.0]
+    res = RUNNER.invoke(app, ["tyre", "plot", "--loads", "300,-1", "--out", str(tmp_path)])
+    assert res.exit_code != 0 and "--loads must be finite and > 0" in res.output
 
 
 def test_peaks_json():

@@ -64,28 +64,47 @@ def evaluate(
             typer.echo(f"{key}: {value:.6g} {units[key]}")
 
 
+LoadsOpt = typer.Option(
+    None, "--loads", help="Comma-separated loads [N], each > 0 (default: FNOMIN x 1/3, 2/3, 1, 4/3 = Fig. B.1's 250-1000 N for FSAE)."
+)
+
+
+def _loads(text: Optional[str]):
+    if text is None:
+        return None
+    try:
+        loads = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        fail(f"--loads must be comma-separated numbers, got {text!r}")
+    if not all(math.isfinite(v) and v > 0.0 for v in loads):
+        fail(f"--loads must be finite and > 0 N, got {text!r}")
+    return loads
+
+
 @app.command()
 def plot(
     tir: Optional[Path] = TirOpt,
     out: Path = typer.Option(..., "--out", help="Folder for the PNGs and peaks.json."),
+    loads: Optional[str] = LoadsOpt,
 ):
-    """The four panels of Fig. B.1 (Fx-kappa, Fy-alpha, Mz-alpha, Fx-Fy at 750 N) as PNGs."""
+    """The four panels of Fig. B.1 (Fx-kappa, Fy-alpha, Mz-alpha, Fx-Fy at FNOMIN) as PNGs."""
     from ..tyre import peak_table, plot_fig_b1
 
     t = _tyre(tir)
+    fz = _loads(loads)
     name = "FSAE 20.0x7.0-13 (shipped)" if tir is None else Path(tir).name
-    paths = plot_fig_b1(t, out, title=name)
-    write_json({"tir": name, "peaks": peak_table(t)}, Path(out) / "peaks.json")
+    paths = plot_fig_b1(t, out, title=name, loads=fz)
+    write_json({"tir": name, "peaks": peak_table(t, fz)}, Path(out) / "peaks.json")
     for p in paths:
         typer.echo(str(p))
 
 
 @app.command()
-def peaks(tir: Optional[Path] = TirOpt, as_json: bool = JsonOpt):
-    """Peak Fx, Fy, Mz at Fz = 250/500/750/1000 N and the slips where they occur."""
+def peaks(tir: Optional[Path] = TirOpt, loads: Optional[str] = LoadsOpt, as_json: bool = JsonOpt):
+    """Peak Fx, |Fy|, Mz per load (FSAE: 250/500/750/1000 N) and the slips where they occur."""
     from ..tyre import peak_table
 
-    rows = peak_table(_tyre(tir))
+    rows = peak_table(_tyre(tir), _loads(loads))
     if as_json:
         emit_json(rows)
         return

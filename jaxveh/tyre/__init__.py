@@ -14,6 +14,7 @@ from ._base import AbstractTyre as AbstractTyre, TyreForces as TyreForces
 from ._curves import (
     PureSlipCurves as PureSlipCurves,
     combined_slip_curves as combined_slip_curves,
+    default_loads as default_loads,
     peak_table as peak_table,
     pure_slip_curves as pure_slip_curves,
 )

@@ -14,11 +14,16 @@ from jaxtyping import Array, Float
 from ._magic_formula import tyre_forces
 from ._model import MagicFormulaTyre
 
-#: Fig. B.1 loads [N] and slip ranges.
-FIG_B1_LOADS: tuple[float, ...] = (250.0, 500.0, 750.0, 1000.0)
+#: Fig. B.1 slip ranges. Its loads, 250/500/750/1000 N, are 1/3, 2/3, 1 and 4/3 of the
+#: shipped tyre's FNOMIN (750 N); :func:`default_loads` applies that rule to any tyre.
 FIG_B1_KAPPA_MAX = 0.3
 FIG_B1_ALPHA_MAX_DEG = 15.0
-FIG_B1_COMBINED_LOAD = 750.0
+
+
+def default_loads(tyre: MagicFormulaTyre) -> tuple[float, ...]:
+    """Loads [N] of the Fig. B.1 panels: FNOMIN x (1/3, 2/3, 1, 4/3) (250-1000 N for FSAE)."""
+    fnomin = float(tyre.fnomin)
+    return tuple(fnomin * k / 3.0 for k in (1, 2, 3, 4))
 
 
 @eqx.filter_jit
@@ -42,14 +47,15 @@ class PureSlipCurves(NamedTuple):
 
 def pure_slip_curves(
     tyre: MagicFormulaTyre,
-    loads=FIG_B1_LOADS,
+    loads=None,
     n: int = 601,
     kappa_max: float = FIG_B1_KAPPA_MAX,
     alpha_max_deg: float = FIG_B1_ALPHA_MAX_DEG,
     gamma: float = 0.0,
 ) -> PureSlipCurves:
-    """Fx(kappa) at alpha = 0, and Fy(alpha), Mz(alpha) at kappa = 0, at each load [N]."""
-    loads = jnp.asarray(loads, dtype=jnp.float64)
+    """Fx(kappa) at alpha = 0, and Fy(alpha), Mz(alpha) at kappa = 0, at each load [N]
+    (default :func:`default_loads`)."""
+    loads = jnp.asarray(default_loads(tyre) if loads is None else loads, dtype=jnp.float64)
     kappa = jnp.linspace(-kappa_max, kappa_max, n)
     alpha = jnp.deg2rad(jnp.linspace(-alpha_max_deg, alpha_max_deg, n))
     zero = jnp.zeros_like(kappa)
@@ -61,12 +67,14 @@ def pure_slip_curves(
 
 def combined_slip_curves(
     tyre: MagicFormulaTyre,
-    fz: float = FIG_B1_COMBINED_LOAD,
+    fz: float | None = None,
     alphas_deg=(1.0, 2.0, 4.0, 6.0, 8.0, 10.0),
     n: int = 301,
     kappa_max: float = FIG_B1_KAPPA_MAX,
 ):
-    """Fx and Fy over kappa in [-kappa_max, kappa_max] at each slip angle (both signs) [N]."""
+    """Fx and Fy over kappa in [-kappa_max, kappa_max] at each slip angle (both signs) [N],
+    at load ``fz`` [N] (default FNOMIN: 750 N for the shipped tyre, as Fig. B.1(d))."""
+    fz = float(tyre.fnomin) if fz is None else fz
     a = np.deg2rad(np.asarray(alphas_deg, dtype=np.float64))
     a = jnp.asarray(np.concatenate([-a[::-1], a]))
     kappa = jnp.linspace(-kappa_max, kappa_max, n)
@@ -81,12 +89,13 @@ def _combined(tyre, fz, alphas, kappa):
     return jax.vmap(jax.vmap(point, in_axes=(None, 0)), in_axes=(0, None))(alphas, kappa)
 
 
-def peak_table(tyre: MagicFormulaTyre, loads=FIG_B1_LOADS, n: int = 3001) -> list[dict[str, float]]:
+def peak_table(tyre: MagicFormulaTyre, loads=None, n: int = 3001) -> list[dict[str, float]]:
     """Peak |Fx|, |Fy|, max and min Mz per load, and the slips where they occur.
 
     Keys: ``fz`` [N], ``fx_peak`` [N] at ``kappa_peak`` [-] (driving side), ``fy_peak``
     [N] = max |Fy| at ``alpha_peak_deg``, ``mz_max`` / ``mz_min`` [Nm] at
-    ``alpha_mz_max_deg`` / ``alpha_mz_min_deg``; over the Fig. B.1 slip ranges. The Fy
+    ``alpha_mz_max_deg`` / ``alpha_mz_min_deg``; over the Fig. B.1 slip ranges, at
+    ``loads`` [N] (default :func:`default_loads`). The Fy
     peak is searched on the positive slip-angle side (ISO-W: Fy < 0 there).
     """
     c = pure_slip_curves(tyre, loads, n=n)

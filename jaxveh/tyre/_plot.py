@@ -4,18 +4,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ._curves import FIG_B1_COMBINED_LOAD, combined_slip_curves, pure_slip_curves
+from ._curves import combined_slip_curves, pure_slip_curves
 from ._model import MagicFormulaTyre
 
 #: File names of the four panels, in the order of Fig. B.1 (a)-(d).
 PANEL_FILES: tuple[str, ...] = ("fx_kappa.png", "fy_alpha.png", "mz_alpha.png", "fx_fy_combined.png")
 
 
-def plot_fig_b1(tyre: MagicFormulaTyre, out_dir: str | Path, title: str = "") -> list[Path]:
+def plot_fig_b1(tyre: MagicFormulaTyre, out_dir: str | Path, title: str = "", loads=None) -> list[Path]:
     """Write the four panels of Fig. B.1 as PNGs (and one 2x2 overview) into ``out_dir``.
 
-    Loads 250/500/750/1000 N, camber 0; combined panel at 750 N with slip angles +-1..10 deg
-    over kappa in [-0.3, 0.3]. Signs as computed (ISO-W). Returns the written paths.
+    Loads [N] default FNOMIN x (1/3, 2/3, 1, 4/3) (Fig. B.1's 250/500/750/1000 N for the
+    shipped tyre), camber 0; combined panel at FNOMIN with slip angles +-1..10 deg over
+    kappa in [-0.3, 0.3]. Signs as computed (ISO-W). Returns the written paths.
     """
     import matplotlib
 
@@ -24,7 +25,7 @@ def plot_fig_b1(tyre: MagicFormulaTyre, out_dir: str | Path, title: str = "") ->
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    c = pure_slip_curves(tyre)
+    c = pure_slip_curves(tyre, loads)
     kappa, alpha_deg = np.asarray(c.kappa), np.rad2deg(np.asarray(c.alpha))
     alphas, _, cfx, cfy = combined_slip_curves(tyre)
     labels = [f"Fz = {fz:.0f} N" for fz in np.asarray(c.loads)]
@@ -46,7 +47,7 @@ def plot_fig_b1(tyre: MagicFormulaTyre, out_dir: str | Path, title: str = "") ->
             for j, a in enumerate(np.rad2deg(np.asarray(alphas))):
                 ax.plot(np.asarray(cfx[j]), np.asarray(cfy[j]), color="C0", lw=1.0)
                 ax.annotate(f"{a:.0f}°", (float(cfx[j][-1]), float(cfy[j][-1])), fontsize=6)
-            ax.set(xlabel="Fx [N]", ylabel="Fy [N]", title=f"(d) Fz = {FIG_B1_COMBINED_LOAD:.0f} N")
+            ax.set(xlabel="Fx [N]", ylabel="Fy [N]", title=f"(d) Fz = {float(tyre.fnomin):.0f} N")
             ax.set_aspect("equal", adjustable="datalim")
         if which < 3:
             ax.legend(fontsize=7)
