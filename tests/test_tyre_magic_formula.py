@@ -252,3 +252,14 @@ def test_no_retrace_when_values_change():
 def test_scalar_outputs_and_dtypes():
     f = FORCES(FSAE, *_pt(500.0, 0.1, 0.1))
     assert all(v.shape == () and v.dtype == jnp.float64 for v in f)
+
+
+def test_lift_off_transition_is_smooth_at_zero_load():
+    """Zero slope at fz = 0 (C1 lift-off) and exact MF above 1 % of FNOMIN."""
+    dfy = jax.grad(lambda fz: jt.tyre_forces(FSAE, fz, 0.05, 0.1, 0.0, 11.0).fy)
+    assert float(dfy(jnp.asarray(1e-9))) == pytest.approx(0.0, abs=1e-6)
+    assert float(dfy(jnp.asarray(-1.0))) == 0.0
+    floor = 0.01 * float(FSAE.fnomin)
+    up = float(dfy(jnp.asarray(floor + 1e-9)))
+    down = float(dfy(jnp.asarray(floor - 1e-9)))
+    assert down == pytest.approx(up, rel=0.1)  # secant vs tangent of a nearly linear curve

@@ -18,9 +18,11 @@ moment Mx, rolling resistance moment My, aligning moment Mz [Nm].
 Numerical treatment (all documented in ``docs/tyre.md``):
 
 - lift-off: the formula is evaluated at ``max(fz, F_floor)`` with ``F_floor =
-  LIFTOFF_FRACTION * FNOMIN * LFZO`` and every output is scaled by ``max(fz, 0) /
-  max(fz, F_floor)``: exactly zero for ``fz <= 0``, linear in ``fz`` below ``F_floor``,
-  exact MF 5.2 above; continuous, with finite gradients everywhere;
+  LIFTOFF_FRACTION * FNOMIN * LFZO`` and every output is scaled by ``s(x) = x^2 (2 - x)``,
+  ``x = clip(fz / F_floor, 0, 1)``: exactly zero for ``fz <= 0``, exact MF 5.2 above
+  ``F_floor``; continuously differentiable at lift-off (zero slope), and at the floor the
+  slope ``F(F_floor)/F_floor`` is the secant of the nearly linear low-load MF; finite
+  gradients everywhere;
 - slips, camber and load are clipped to wide finite bands (``SLIP_CLIP``, ``CAMBER_CLIP``,
   ``LOAD_CLIP_FACTOR``) only so that no finite input produces inf - inf;
 - speed only enters the rolling resistance moment, whose sign follows
@@ -151,7 +153,8 @@ def tyre_forces(
     # lift-off: evaluate at a positive load, scale to zero below the floor
     floor = LIFTOFF_FRACTION * fz0
     fz_eval = jnp.clip(fz, floor, LOAD_CLIP_FACTOR * fz0)
-    scale = jnp.maximum(fz, 0.0) / jnp.maximum(fz, floor)
+    x = jnp.clip(fz / floor, 0.0, 1.0)
+    scale = x * x * (2.0 - x)  # 0 at lift-off with zero slope, 1 (slope 1/floor) at the floor
     fz = fz_eval
     dfz = (fz - fz0) / fz0
 
