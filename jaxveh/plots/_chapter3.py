@@ -41,13 +41,17 @@ def plot_design_curves(x, curves: dict, xlabel: str, ylabel: str, log_x: bool = 
     return fig if fig is not None else ax.figure
 
 
-def plot_map(report: dict, label: str, ax=None):
-    """Filled contour of a λ x µ map report (Figs. 3.3c-d, 3.4c), µ on a log axis."""
+def plot_map(report: dict, label: str, ax=None, vmax: float | None = None):
+    """Filled contour of a λ x µ map report (Figs. 3.3c-d, 3.4c), µ on a log axis.
+
+    ``vmax`` clips the colour scale (the thesis uses 0.6, 2 and 0.3 for Figs. 3.3c, 3.3d, 3.4c).
+    """
     fig = None
     if ax is None:
         fig, ax = plt.subplots(figsize=(5, 4))
     mu, lam, values = np.asarray(report["mu"]), np.asarray(report["lam"]), np.asarray(report["values"])
-    cs = ax.contourf(mu, lam, values, levels=20, cmap="viridis")
+    vmax = float(values.max()) if vmax is None else vmax
+    cs = ax.contourf(mu, lam, np.minimum(values, vmax), levels=np.linspace(0.0, vmax, 21), cmap="viridis")
     ax.contour(mu, lam, values, levels=[0.02, 0.05], colors="w", linewidths=0.8)
     ax.set_xscale("log")
     ax.set_xlabel("µ")
@@ -67,6 +71,8 @@ def plot_skidpad(report: dict, labels: dict | None = None):
     ax1.set_ylabel("δd [deg]")
     ax2.set_xlabel("ay [g]")
     ax2.set_ylabel("1/ku [g/deg]")
+    # 1/ku diverges where δd peaks (neutral steer); keep the thesis's scale, data stay in the JSON.
+    ax2.set_ylim(-0.5, 1.6)
     for ax, tag in ((ax1, "(a)"), (ax2, "(b)")):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
@@ -96,9 +102,10 @@ def plot_root_locus(loci: dict, ax=None, title: str = ""):
     fig = None
     if ax is None:
         fig, ax = plt.subplots(figsize=(5.5, 4.5))
-    for label, eig in loci.items():
+    for k, (label, eig) in enumerate(loci.items()):
         eig = np.asarray(eig)
-        ax.plot(eig.real, eig.imag, ".", ms=3, label=label)
+        ax.plot(eig.real, eig.imag, ".", ms=3, color=f"C{k}")
+        ax.plot([], [], ".", color=f"C{k}", label=label)
         ax.plot(eig[0].real, eig[0].imag, "s", mfc="none", color="k", ms=5)
         ax.plot(eig[-1].real, eig[-1].imag, "o", mfc="none", color="k", ms=5)
     xmin, xmax = ax.get_xlim()
