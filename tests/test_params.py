@@ -128,3 +128,12 @@ def test_every_leaf_differentiable_and_vmappable():
     batch = jax.tree.map(lambda x: jnp.stack([x, 2.0 * x]), v)
     out = jax.vmap(lambda veh: veh.kF + veh.kR)(batch)
     np.testing.assert_allclose(out, [float(v.kF + v.kR), 2.0 * float(v.kF + v.kR)])
+
+
+def test_data_documentation_is_current():
+    from pathlib import Path
+
+    from jaxveh.params._docs import render
+
+    doc = Path(__file__).resolve().parents[1] / "docs" / "data.md"
+    assert doc.read_text() == render(), "docs/data.md is stale: run python -m jaxveh.params.docs"

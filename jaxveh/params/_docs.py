@@ -1,0 +1,41 @@
+"""Markdown documentation of the data-file schemas (written to ``docs/data.md``)."""
+
+from . import _appendix_a, _appendix_b
+from ._schema import schema_markdown
+
+HEADER = """# Vehicle data files
+
+Generated from the schemas in `jaxveh/params` by `python -m jaxveh.params.docs`; a test
+checks that this file is current. Values are written in the unit of the column *unit*
+and converted to SI on load; a value outside *allowed* raises `ParameterError` naming
+the file, section and key.
+
+## Appendix A: the chapter-3 analytic vehicle (`appendix_a.toml`)
+
+Consistency checks: `m = ms + muF + muR`, `l = a + b = as + bs` (c.g. inside the
+wheelbase), `hsF > zF`, `hsR > zR` (relative tolerance 1e-3).
+
+"""
+
+MIDDLE = """
+
+## Appendix B: the 14-DOF vehicle (`appendix_b.toml`)
+
+Sections `[hard_points_front]` and `[hard_points_rear]` hold the 14 hard points
+A, B, C, D, E, F, H, L, M, P, Q, R, S, T of the left corner as `[x, y, z]` in mm
+(Tables B.2, B.3), in the corner frame: origin on the ground in the vehicle centre plane
+below the axle centre, x forward, y left (y > 0 required), z up. The product of inertia
+must keep the inertia tensor positive definite (|Jxz| < sqrt(Jxx Jzz)).
+
+"""
+
+
+def render() -> str:
+    """The full Markdown text of ``docs/data.md``."""
+    b_sections = {
+        "general": _appendix_b.GENERAL,
+        "sprung": _appendix_b.SPRUNG,
+        "unsprung_front / unsprung_rear": _appendix_b.UNSPRUNG,
+        "tyre": _appendix_b.TYRE,
+    }
+    return HEADER + schema_markdown(_appendix_a.SCHEMA) + MIDDLE + schema_markdown(b_sections) + "\n"
