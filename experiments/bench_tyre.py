@@ -75,7 +75,7 @@ def main() -> None:
     jax.block_until_ready(chained(tyre, x4))
     in_graph_four = _time(chained, tyre, x4, repeat=3) / loops
 
-    m = 10_000
+    m = 100_000
     sub = [p[:m] for p in pts]
     params, static = eqx.partition(tyre, eqx.is_inexact_array)
 
@@ -87,7 +87,7 @@ def main() -> None:
     grad = eqx.filter_jit(jax.grad(loss))
     jax.block_until_ready(fwd(params, *sub))
     jax.block_until_ready(grad(params, *sub))
-    ratio = _time(grad, params, *sub) / _time(fwd, params, *sub)
+    ratio = _time(grad, params, *sub, repeat=7) / _time(fwd, params, *sub, repeat=7)
 
     result = {
         "device": str(jax.devices()[0]),
