@@ -6,8 +6,11 @@ These are examples *of* the library; the library itself (``jaxveh.multibody``) k
 nothing about vehicles. Each builder returns ``(system, params)``.
 """
 
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
+
+from ..params import HARD_POINT_NAMES, ParameterError, float_field, load_vehicle_data
 
 from ._rotations import rotation_matrix
 from ._system import System, SystemBuilder, SystemParams
@@ -192,8 +195,6 @@ _UPRIGHT_POINTS = ("C", "H", "M")
 
 
 def _hard_point(points, name):
-    from ..params import HARD_POINT_NAMES
-
     return points[HARD_POINT_NAMES.index(name)]
 
 
@@ -210,8 +211,6 @@ def quarter_car(data=None, axle: str = "front") -> tuple[System, SystemParams]:
     the sprung side); the thesis's wording "moves points M" describes the same rack.
     Independent velocities: ``upright.uz`` (bump) and ``wheel.theta_dot`` (spin).
     """
-    from ..params import load_vehicle_data
-
     data = load_vehicle_data() if data is None else data
     hp = (data.hard_points_front if axle == "front" else data.hard_points_rear).points
     unsprung = data.unsprung_front if axle == "front" else data.unsprung_rear
@@ -227,6 +226,7 @@ def quarter_car(data=None, axle: str = "front") -> tuple[System, SystemParams]:
         b.add_point(name, "ground", np.asarray(_hard_point(hp, name)), **kwargs)
     for name in _UPRIGHT_POINTS:
         b.add_point(name, "upright", np.asarray(_hard_point(hp, name)) - w)
+    b.add_point("W", "upright", (0.0, 0.0, 0.0))  # wheel centre, where road loads are applied
     for link, p, q in QUARTER_CAR_LINKS:
         length = np.linalg.norm(np.asarray(_hard_point(hp, p)) - np.asarray(_hard_point(hp, q)))
         b.add_link(link, p, q, length)
@@ -244,7 +244,6 @@ def quarter_car_design_q(system: System, wheel_centre=None):
 def quarter_car_with_hard_points(system: System, params: SystemParams, hard_points, wheel_centre) -> SystemParams:
     """Parameters for new hard points (14 x 3, m, corner frame) and wheel centre (m): point
     positions and link lengths recomputed with JAX, so gradients flow to the hard points."""
-    import equinox as eqx
 
     hard_points, w = jnp.asarray(hard_points), jnp.asarray(wheel_centre)
     points = list(params.points)
@@ -260,6 +259,31 @@ def quarter_car_with_hard_points(system: System, params: SystemParams, hard_poin
         length = jnp.linalg.norm(_hard_point(hard_points, p) - _hard_point(hard_points, q))
         joints[k] = eqx.tree_at(lambda j: j.length, joints[k], length)
     return eqx.tree_at(lambda s: (s.points, s.joints), params, (tuple(points), tuple(joints)))
+
+
+class WheelRate(eqx.Module):
+    """Vertical spring-damper between the chassis and the wheel centre ``W`` (the quarter car's
+    suspension reduced to a wheel rate): stiffness ``k`` (N/m), damping ``c`` (Ns/m), force
+    free at wheel-centre height ``z0`` (m); plus a constant vertical load ``fz`` (N)."""
+
+    k: jnp.ndarray = float_field()
+    c: jnp.ndarray = float_field()
+    z0: jnp.ndarray = float_field()
+    fz: jnp.ndarray = float_field(default=0.0)
+
+    def force(self, system: System, params: SystemParams, q, v):
+        """Generalised force (``v`` coordinates) on the upright."""
+        from ._dynamics import point_force
+
+        a = rotation_matrix(system.sequence[0], q[3:6])
+        z_dot = (a @ v[:3])[2]
+        fz = self.fz - self.k * (q[2] - self.z0) - self.c * z_dot
+        zero = jnp.zeros_like(fz)
+        return point_force(system, params, q, "W", jnp.stack([zero, zero, fz]))
+
+    def energy(self, q):
+        """Spring energy (J) plus the potential of the constant load."""
+        return 0.5 * self.k * (q[2] - self.z0) ** 2 - self.fz * q[2]
 
 
 def wheel_angles(system: System, params: SystemParams, q):
@@ -359,8 +383,6 @@ _DEFAULT_Q = {
 
 def _example_state(name, q, qdot, values):
     """``(system, params, q_full, z, inputs, param_values)`` for an example at (q, qdot)."""
-    from ..params import ParameterError
-
     if name == "double-pendulum":
         unknown = sorted(set(values) - set(DOUBLE_PENDULUM_DEFAULTS))
         if unknown:
@@ -406,7 +428,6 @@ def inspect_example(name: str, q=None, qdot=None, values: dict | None = None) ->
     ``external_forces``: gravity (and applied loads) reduced, ``R^T T^T Q_ext``. For the
     double pendulum these are the ``M``, ``Qi``, ``Qe`` printed in thesis section 5.7.
     """
-    from ..params import ParameterError
     from ._projection import dynamics
 
     if name not in EXAMPLES:
