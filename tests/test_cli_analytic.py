@@ -66,3 +66,14 @@ def test_bad_input_named_errors(args, message):
     result = runner.invoke(app, args)
     assert result.exit_code == 2
     assert message in result.output
+
+
+def test_preview_contract():
+    out = _json(["analytic", "preview", "--speed-kmh", "100", "--mu", "1", "--json"])
+    assert isinstance(out["preview_distance_m"], float)
+    assert len(out["gains"]) == 201 and all(isinstance(g, float) for g in out["gains"])
+    # Lp is a multiple of u dt and lies within the previewed 200 points.
+    step = 100 / 3.6 * 0.01
+    assert 0 < out["preview_distance_m"] <= 200 * step
+    assert out["preview_distance_m"] / step == pytest.approx(round(out["preview_distance_m"] / step), abs=1e-9)
+    assert out["riccati_residual"] < 1e-9

@@ -4,8 +4,12 @@ their units in the key names."""
 
 import numpy as np
 
+import jax.numpy as jnp
+
+from ..control import preview_controller, preview_distance
 from ..params import AnalyticVehicle
 from ._inputs import SmoothStep
+from ._linear import state_space
 from ._load_transfer import load_transfer_summary
 from ._maps import design_map, minimum_stiffness
 from ._model import PHIF, PHIR, R, VARIANTS
@@ -146,3 +150,28 @@ def map_report(vehicle: AnalyticVehicle, quantity: str, lam_range=(0.0, 1.0), mu
     mu = np.geomspace(*mu_range, n_mu)
     values = np.asarray(design_map(vehicle, quantity, lam, mu))
     return {"quantity": quantity, "lam": lam.tolist(), "mu": mu.tolist(), "values": values.tolist()}
+
+
+def preview_report(vehicle: AnalyticVehicle, speed_kmh=100.0, rigid=False, dt=0.01, n_preview=200, q_weight=1000.0, r_weight=1.0, cutoff_hz=2.0) -> dict:
+    """Time-invariant optimal preview control (section 3.3.6): preview gains Kp (deg of
+    steering-wheel angle per m of road lateral position) at distances l = i u dt (m) and
+    the preview distance Lp (eq. 3.46, 98 % of the area under |Kp|)."""
+    _positive("speed_kmh", speed_kmh)
+    _positive("dt", dt)
+    if n_preview < 2:
+        raise ValueError(f"n_preview must be >= 2, got {n_preview}")
+    speed = speed_kmh * KMH
+    a_c, b_c = state_space(vehicle, speed, rigid=rigid)
+    c_y = jnp.zeros(a_c.shape[0]).at[0].set(1.0)
+    gains = preview_controller(a_c, b_c, c_y, dt=dt, n_preview=n_preview, q_weight=q_weight, r_weight=r_weight, cutoff_hz=cutoff_hz)
+    kp = np.degrees(np.asarray(gains.preview))
+    return {
+        "speed_kmh": speed_kmh,
+        "rigid": rigid,
+        "mu": float(normalised_torsional_stiffness(vehicle)),
+        "preview_distance_m": float(preview_distance(gains.preview, speed, dt)),
+        "distance_m": (np.arange(kp.size) * speed * dt).tolist(),
+        "gains": kp.tolist(),
+        "riccati_residual": float(gains.residual),
+        "closed_loop_spectral_radius": float(gains.spectral_radius),
+    }

@@ -9,7 +9,7 @@ import typer
 from ..analytic import _reports as reports
 from ..analytic import eigenvalues, with_distribution
 from ..params import ParameterError, load_analytic_vehicle
-from ..plots import plot_bode, plot_map, plot_root_locus, plot_skidpad, plot_step_steer, save
+from ..plots import plot_bode, plot_map, plot_preview, plot_root_locus, plot_skidpad, plot_step_steer, save
 from ._common import emit_json, fail, write_json
 
 app = typer.Typer(help="Chapter-3 analytic models (Appendix A vehicle by default).", no_args_is_help=True)
@@ -156,6 +156,28 @@ def bode(
         for name in ("rigid", "flexible")
     }
     _finish(result, as_json, out, "bode", summary)
+
+
+@app.command()
+def preview(
+    vehicle: Optional[Path] = VehicleOpt,
+    lam: Optional[float] = LamOpt,
+    mu: Optional[float] = MuOpt,
+    speed_kmh: float = typer.Option(100.0, "--speed-kmh", help="Speed (km/h)."),
+    rigid: bool = typer.Option(False, "--rigid", help="Rigid chassis (φF = φR)."),
+    n_preview: int = typer.Option(200, "--n-preview", help="Preview points q."),
+    dt: float = typer.Option(0.01, "--dt", help="Sample time (s)."),
+    as_json: bool = JsonOpt,
+    plot: Optional[Path] = PlotOpt,
+):
+    """Optimal preview gains (deg/m) and preview distance Lp (m), eqs. 3.38-3.46 (Fig. 3.11)."""
+    result = _run(reports.preview_report, _vehicle(vehicle, lam, mu), speed_kmh, rigid, dt, n_preview)
+    if plot is not None:
+        save(plot_preview({"rigid" if rigid else f"µ = {result['mu']:g}": result}), plot)
+    if as_json:
+        emit_json(result)
+    else:
+        typer.echo(f"preview distance Lp = {result['preview_distance_m']:.2f} m at {speed_kmh:g} km/h (Riccati residual {result['riccati_residual']:.1e})")
 
 
 @app.command("map")

@@ -4,6 +4,7 @@ from ._chapter3 import (
     plot_bode as plot_bode,
     plot_design_curves as plot_design_curves,
     plot_map as plot_map,
+    plot_preview as plot_preview,
     plot_root_locus as plot_root_locus,
     plot_skidpad as plot_skidpad,
     plot_step_steer as plot_step_steer,

@@ -145,3 +145,17 @@ def plot_bode(report: dict):
     axes[0, 0].set_title("(a) yaw rate / steer", fontsize=9)
     axes[0, 1].set_title("(b) lateral acceleration / steer", fontsize=9)
     return fig
+
+
+def plot_preview(reports: dict, ax=None):
+    """Preview gains Kp (deg/m) versus distance ahead l (m) for labelled reports (Fig. 3.11a-b)."""
+    fig = None
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(5, 4))
+    for label, report in reports.items():
+        ax.plot(report["distance_m"], report["gains"], label=f"{label} (Lp = {report['preview_distance_m']:.1f} m)")
+    ax.set_xlabel("l [m]")
+    ax.set_ylabel("Kp [deg/m]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig if fig is not None else ax.figure
