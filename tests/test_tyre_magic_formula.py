@@ -1,6 +1,7 @@
 """MF 5.2 forces: signs, symmetry, Fig. B.1 peaks, closed forms, combined slip, robustness,
 gradients (slips and coefficients) against finite differences, vmap, no retrace."""
 
+import dataclasses
 from pathlib import Path
 
 import equinox as eqx
@@ -226,7 +227,7 @@ def test_gradient_wrt_every_coefficient_matches_finite_differences():
     assert np.count_nonzero(g) > 100  # most coefficients influence this point
 
 
-def test_vmap_over_loads_and_over_tyres():
+def test_vmap_over_loads_and_over_tyres(tmp_path):
     loads = jnp.asarray([250.0, 500.0, 750.0, 1000.0])
     per_load = jax.vmap(lambda fz: jt.tyre_forces(FSAE, fz, 0.1, 0.05, 0.0, 11.0))(loads)
     for i, fz in enumerate(np.asarray(loads)):
@@ -237,6 +238,12 @@ def test_vmap_over_loads_and_over_tyres():
     for i, t in enumerate((FSAE, other)):
         np.testing.assert_allclose(per_tyre.fy[i], FORCES(t, *_pt(600.0, 0.0, 0.15)).fy, rtol=1e-13)
     assert float(per_tyre.fy[1]) < float(per_tyre.fy[0]) < 0.0  # more grip, more (negative) force
+    # tyres from different files (different static extras) stack with stack_tyres
+    both = jt.stack_tyres([FIXTURE, jt.read_tir(jt.write_tir(tmp_path / "f.tir", dataclasses.replace(FIXTURE, extras=())))])
+    fy = jax.vmap(lambda t: jt.tyre_forces(t, 3000.0, 0.02, 0.05, 0.01, 20.0).fy)(both)
+    np.testing.assert_allclose(fy[0], fy[1], rtol=1e-14)
+    with pytest.raises(ValueError, match="differ in"):
+        jt.stack_tyres([FSAE, FIXTURE])
 
 
 def test_no_retrace_when_values_change():

@@ -32,6 +32,7 @@ from ._model import (
     SUPPORTED_FITTYP as SUPPORTED_FITTYP,
     MagicFormulaTyre as MagicFormulaTyre,
     coefficient_names as coefficient_names,
+    stack_tyres as stack_tyres,
 )
 from ._plot import PANEL_FILES as PANEL_FILES, plot_fig_b1 as plot_fig_b1
 from ._tir import (

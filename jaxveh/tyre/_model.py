@@ -13,6 +13,8 @@ the MF 5.2 load-dependent forms (``PTX1``, ``PTY1``).
 import dataclasses
 
 import equinox as eqx
+import jax
+import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
 from ..params import float_field
@@ -251,3 +253,23 @@ def coefficient_fields() -> tuple[dataclasses.Field, ...]:
 def coefficient_names() -> tuple[str, ...]:
     """Lower-case names of all numeric coefficients."""
     return tuple(f.name for f in coefficient_fields())
+
+
+def stack_tyres(tyres) -> MagicFormulaTyre:
+    """Stack tyres along a new leading axis of every coefficient, for ``jax.vmap``.
+
+    Tyres read from different files differ in their static ``extras`` (kept only for
+    writing ``.tir`` files); the stacked tyre drops them. ``fittyp`` and
+    ``relaxation_model`` must agree (they change the computation).
+
+    Raises:
+        ValueError: no tyres, or differing ``relaxation_model`` / ``fittyp``.
+    """
+    tyres = list(tyres)
+    if not tyres:
+        raise ValueError("stack_tyres needs at least one tyre")
+    models = {(t.fittyp, t.relaxation_model) for t in tyres}
+    if len(models) > 1:
+        raise ValueError(f"stack_tyres: tyres differ in (fittyp, relaxation_model): {sorted(models)}")
+    bare = [dataclasses.replace(t, extras=()) for t in tyres]
+    return jax.tree.map(lambda *x: jnp.stack(x), *bare)
