@@ -84,6 +84,9 @@ def test_fit_bad_csv(tmp_path):
     p.write_text("fz,kappa\n1,2\n")
     res = RUNNER.invoke(app, ["tyre", "fit", str(p), "--out", str(tmp_path / "x.tir")])
     assert res.exit_code != 0 and "missing column" in res.output
+    p.write_text("fz,kappa,alpha,gamma,fx,fy,mz\n500,0,0,0,0,0,0\n")
+    res = RUNNER.invoke(app, ["tyre", "fit", str(p), "--out", str(tmp_path / "x.tir"), "--start", "no/such.tir"])
+    assert res.exit_code != 0 and "--start: file not found" in res.output
 
 
 @pytest.mark.slow

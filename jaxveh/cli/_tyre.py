@@ -16,15 +16,15 @@ TirOpt = typer.Option(None, "--tir", help=".tir property file (default: the ship
 JsonOpt = typer.Option(False, "--json", help="Print a machine-readable JSON result on stdout.")
 
 
-def _tyre(path: Optional[Path]):
+def _tyre(path: Optional[Path], option: str = "--tir"):
     from ..tyre import load_fsae_tyre, read_tir
 
     try:
         return load_fsae_tyre() if path is None else read_tir(path)
     except FileNotFoundError:
-        fail(f"--tir: file not found: {path}")
+        fail(f"{option}: file not found: {path}")
     except (ParameterError, ValueError) as e:
-        fail(f"--tir: {e}")
+        fail(f"{option}: {e}")
 
 
 def _finite(value: float, option: str) -> float:
@@ -135,7 +135,7 @@ def fit(
         measurements = read_tyre_csv(data)
     except ParameterError as e:
         fail(f"DATA: {e}")
-    report = fit_tir(measurements, None if start is None else _tyre(start), max_steps=max_steps)
+    report = fit_tir(measurements, None if start is None else _tyre(start, "--start"), max_steps=max_steps)
     write_tir(out, report.tyre)
     result = {"tir": str(out), "rows": int(np.asarray(measurements.fz).shape[0]), "stages": list(report.stages)}
     if as_json:
