@@ -106,3 +106,16 @@ def test_vmap_over_distribution(vehicle):
     batched = jax.vmap(lambda lam: chi(with_distribution(vehicle, lam=lam, mu=2.0)))(lams)
     single = [float(chi(with_distribution(vehicle, lam=float(x), mu=2.0))) for x in lams]
     np.testing.assert_allclose(batched, single, rtol=EXACT)
+
+
+def test_new_parameter_values_do_not_retrace(vehicle):
+    import equinox as eqx
+
+    @eqx.filter_jit
+    @eqx.debug.assert_max_traces(max_traces=1)
+    def summary(v):
+        return chi(v), chi_sensitivity(v)
+
+    summary(vehicle)
+    summary(with_distribution(vehicle, lam=0.3, mu=2.0))
+    summary(with_distribution(vehicle, lam=0.7))
