@@ -136,6 +136,8 @@ def test_preview_distance_closed_forms():
     np.testing.assert_allclose(preview_distance(kp, u, DT), n * u * DT)
     interpolated = preview_distance(kp, u, DT, interpolate=True)
     assert (n - 1) * u * DT < float(interpolated) <= n * u * DT
+    with pytest.raises(eqx.EquinoxRuntimeError, match="preview gains are all zero"):
+        preview_distance(jnp.zeros(10), u, DT)
 
 
 def test_gradients_match_finite_differences():

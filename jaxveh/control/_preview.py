@@ -184,6 +184,11 @@ def preview_distance(
     **Arguments:** ``preview`` the gains (any unit), ``speed`` ``u`` in m/s, ``dt`` in s.
     """
     magnitude = jnp.abs(jnp.asarray(preview))
+    magnitude = eqx.error_if(
+        magnitude,
+        ~(jnp.sum(magnitude) > 0.0),
+        "preview_distance: the preview gains are all zero or not finite; Lp is undefined.",
+    )
     cumulative = jnp.cumsum(magnitude)
     target = fraction * cumulative[-1]
     n = jnp.argmax(cumulative > target)

@@ -9,7 +9,7 @@ Forward solve: the structure-preserving doubling algorithm (SDA) of Chu, Fan and
 ``H`` converges quadratically to the stabilising solution ``P`` whenever ``(a, b)`` is
 stabilisable and ``(a, q)`` detectable; eigenvalues of ``a`` on the unit circle (the
 integrators of a vehicle's lateral position and heading) are allowed. Each step costs a
-few dense ``n x n`` products, so a 213-state preview plant converges in ~20 steps.
+few dense ``n x n`` products; the 213-state preview plant converges in ~10 steps.
 
 Gradients: implicit function theorem, not differentiation through the iterations. At the
 optimum, ``P = Acl^T P Acl + k^T r k + q`` with ``Acl = a - b k`` and ``k`` stationary
