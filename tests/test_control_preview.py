@@ -16,7 +16,6 @@ import scipy.linalg
 from jaxveh.control import preview_controller, preview_distance, preview_plant, zoh
 
 DT = 0.01
-N_PREVIEW = 200
 Q_WEIGHT = 1000.0
 #: Riccati solution of the 209-state plant vs SciPy's Schur solver (P entries span ~1e6).
 SOLUTION_RTOL = 1e-9

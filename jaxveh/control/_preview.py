@@ -17,7 +17,7 @@ split into filter gains ``Kf``, vehicle-state gains ``Kd`` and preview gains ``K
 
 import equinox as eqx
 import jax.numpy as jnp
-from jaxtyping import Array, Float, Int
+from jaxtyping import Array, Float
 
 from ._butterworth import butterworth_lowpass
 from ._discretise import zoh
