@@ -7,10 +7,19 @@ Everything numeric is differentiable with respect to section sizes, materials an
 coordinates.
 """
 
+from ._analysis import (
+    METHODS as METHODS,
+    chassis_modes as chassis_modes,
+    compare_reductions as compare_reductions,
+    export_npz as export_npz,
+    mode_labels as mode_labels,
+)
 from ._assembly import (
     Mesh as Mesh,
     assemble as assemble,
+    element_centres as element_centres,
     element_matrices as element_matrices,
+    element_strain_energy as element_strain_energy,
     frame_mass as frame_mass,
     frame_mesh as frame_mesh,
     mesh_xyz as mesh_xyz,
@@ -29,11 +38,18 @@ from ._body import (
     straight_beam_body as straight_beam_body,
     straight_tube_frame as straight_tube_frame,
 )
+from ._craig_bampton import CraigBampton as CraigBampton, craig_bampton as craig_bampton
 from ._frame import (
     Frame as Frame,
     TorsionTest as TorsionTest,
     frame_from_dict as frame_from_dict,
     load_frame as load_frame,
+)
+from ._import import (
+    ExternalModel as ExternalModel,
+    external_modal_body as external_modal_body,
+    external_model_from_arrays as external_model_from_arrays,
+    load_external_model as load_external_model,
 )
 from ._invariants import (
     ModalBody as ModalBody,
@@ -42,6 +58,12 @@ from ._invariants import (
     modal_invariants as modal_invariants,
     skew as skew,
 )
+from ._static import (
+    TorsionResult as TorsionResult,
+    solve_static as solve_static,
+    torsion_test as torsion_test,
+)
+from ._mac import mac as mac, nrfd as nrfd
 from ._modal import (
     DEGENERACY_RTOL as DEGENERACY_RTOL,
     free_free_modes as free_free_modes,

@@ -108,6 +108,7 @@ def _element_data(frame: Frame):
     return length, rot, sec, mat
 
 
+@eqx.filter_jit
 def element_matrices(frame: Frame) -> tuple[Float[Array, "e 12 12"], Float[Array, "e 12 12"]]:
     """Global-axes element stiffness and mass matrices of every element."""
     length, rot, sec, mat = _element_data(frame)
@@ -143,6 +144,7 @@ def point_mass_matrix(frame: Frame) -> Float[Array, "n n"]:
     return jnp.diag(diag.at[idx].add(vals))
 
 
+@eqx.filter_jit
 def assemble(frame: Frame) -> tuple[Float[Array, "n n"], Float[Array, "n n"]]:
     """Global stiffness ``K`` (N/m, Nm/rad) and mass ``M`` (kg, kg m^2), dense, symmetric."""
     ke, me = element_matrices(frame)
@@ -152,6 +154,7 @@ def assemble(frame: Frame) -> tuple[Float[Array, "n n"], Float[Array, "n n"]]:
     return 0.5 * (K + K.T), 0.5 * (M + M.T)
 
 
+@eqx.filter_jit
 def frame_mass(frame: Frame) -> Float[Array, ""]:
     """Total mass (kg): tubes (rho A L summed over members) plus point masses."""
     length, _, sec, mat = _element_data(frame)
@@ -161,3 +164,18 @@ def frame_mass(frame: Frame) -> Float[Array, ""]:
 def with_sections(frame: Frame, sections) -> Frame:
     """Return ``frame`` with its tuple of sections replaced (for design studies)."""
     return eqx.tree_at(lambda f: f.sections, frame, tuple(sections))
+
+
+@eqx.filter_jit
+def element_strain_energy(frame: Frame, u: Float[Array, "n"]) -> Float[Array, "e"]:
+    """Strain energy ``½ u_eᵀ k_e u_e`` (J) of every element for global displacement ``u``."""
+    ke, _ = element_matrices(frame)
+    ue = u[frame_mesh(frame).dof_index]
+    return 0.5 * jnp.einsum("ei,eij,ej->e", ue, ke, ue)
+
+
+def element_centres(frame: Frame) -> Float[Array, "e 3"]:
+    """Mid-points of all elements (m)."""
+    xyz = mesh_xyz(frame)
+    el = frame_mesh(frame).elements
+    return 0.5 * (xyz[el[:, 0]] + xyz[el[:, 1]])

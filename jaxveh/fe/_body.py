@@ -1,5 +1,6 @@
 """From a frame to a :class:`ModalBody`: nodal lumped masses, modes, invariants."""
 
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
@@ -26,6 +27,7 @@ def split_modes(phi: Float[Array, "n6 N"]) -> tuple[Float[Array, "n 3 N"], Float
     return r[:, :3, :], r[:, 3:, :]
 
 
+@eqx.filter_jit
 def frame_modal_body(
     frame: Frame,
     n_modes: int,
