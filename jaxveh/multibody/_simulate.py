@@ -67,6 +67,29 @@ def assemble(
     return q
 
 
+#: ``simulate`` refuses initial coordinates whose constraint residual exceeds this (m or rad).
+INITIAL_RESIDUAL_TOL = 1e-8
+
+
+def _check_assembled(system, params, q0, t0, inputs):
+    """Raise (concrete values) or flag at run time (traced) an unassembled ``q0``."""
+    if system.n_constraints == 0:
+        return q0
+    phi = jnp.abs(constraints(system, params, q0, input_values(system, inputs, jnp.asarray(t0, q0.dtype), q0.dtype)))
+    if not isinstance(phi, jax.core.Tracer):
+        r = np.asarray(phi)
+        if not np.all(r <= INITIAL_RESIDUAL_TOL):
+            k = int(np.argmax(np.where(np.isfinite(r), r, np.inf)))
+            raise AssemblyError(
+                f"initial configuration is not assembled: constraint {system.constraint_names[k]} residual "
+                f"{r[k]:.3e} > {INITIAL_RESIDUAL_TOL:g}; call assemble() first"
+            )
+        return q0
+    return eqx.error_if(
+        q0, jnp.max(phi) > INITIAL_RESIDUAL_TOL, "initial configuration is not assembled; call assemble() first"
+    )
+
+
 def independent_velocities(system: System, y) -> Float[Array, " ndof"]:
     """``z = P y`` (eq. 5.52)."""
     return jnp.asarray(y)[jnp.asarray(system.independent)]
@@ -198,6 +221,7 @@ def simulate(
     """
     q0, z0 = jnp.asarray(q0, jnp.float64), jnp.asarray(z0, jnp.float64)
     ts = jnp.linspace(t0, t1, 101) if ts is None else jnp.asarray(ts, jnp.float64)
+    q0 = _check_assembled(system, params, q0, t0, inputs)
     solver = diffrax.Tsit5() if solver is None else solver
     if project and system.n_constraints:
         solver = ProjectedSolver(solver, system)
