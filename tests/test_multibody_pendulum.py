@@ -185,3 +185,37 @@ def test_singular_reduced_mass_matrix_is_reported():
     system, params = b.build()
     with pytest.raises(mb.SingularMassMatrixError, match=r"\['B1.wx'\] carry no inertia"):
         mb.check_mass_matrix(system, params, jnp.zeros(6))
+
+
+def test_table_5_3_routines_consistent():
+    """T, B, B T, their time derivatives and dX/dq agree with each other and with finite
+    differences along the motion."""
+    system, params = ex.double_pendulum()
+    q, z = ex.double_pendulum_state(system, params, (0.4, 0.9), (1.3, -0.7))
+
+    @jax.jit
+    def routines(q, z):
+        y = mb.projection(system, params, q).R @ z
+        t_mat = mb.recursion_matrix(system, params, q)
+        b_mat = mb.velocity_matrix_b(system, params, q)
+        bt = mb.velocity_matrix(system, params, q)
+        q_dot = bt @ y
+        return y, t_mat, b_mat, bt, q_dot, mb.recursion_matrix_dot(system, params, q, q_dot), mb.marker_jacobian(
+            system, params, q
+        )
+
+    y, t_mat, b_mat, bt, q_dot, t_dot, dxdq = routines(q, z)
+    np.testing.assert_allclose(b_mat @ t_mat, bt, atol=1e-14)
+    h = 1e-6
+    fd = (mb.recursion_matrix(system, params, q + h * q_dot) - mb.recursion_matrix(system, params, q - h * q_dot)) / (2 * h)
+    np.testing.assert_allclose(t_dot, fd, atol=1e-8)
+    # dX/dq q_dot is the marker velocity
+    vel = jnp.einsum("pij,j->pi", dxdq, q_dot)
+    np.testing.assert_allclose(vel[system.point_index("P3")], mb.point_velocity(system, params, q, y, "P3"), atol=1e-13)
+
+
+def test_simulate_rejects_unassembled_initial_state():
+    system, params = ex.double_pendulum()
+    q, z = ex.double_pendulum_state(system, params, (0.4, 0.9), (1.3, -0.7))
+    with pytest.raises(mb.AssemblyError, match=r"constraint C\d\[.\] residual 1.000e-02"):
+        mb.simulate(system, params, q.at[7].add(0.01), z, 0.0, 1.0)

@@ -36,9 +36,11 @@ from ._kinematics import (
     marker_positions as marker_positions,
     point_velocity as point_velocity,
     recursion_matrix as recursion_matrix,
+    recursion_matrix_dot as recursion_matrix_dot,
     velocity_maps as velocity_maps,
     velocity_matrix as velocity_matrix,
     velocity_matrix_b as velocity_matrix_b,
+    velocity_matrix_dot as velocity_matrix_dot,
 )
 from ._projection import (
     Dynamics as Dynamics,

@@ -189,6 +189,16 @@ def velocity_matrix_b(system: System, params: SystemParams, q) -> Float[Array, "
     return jax.jacfwd(qdot)(jnp.zeros((system.n_v,), q.dtype))
 
 
+def recursion_matrix_dot(system: System, params: SystemParams, q, q_dot) -> Float[Array, "nv ny"]:
+    """``pTdot``: time derivative of ``T`` along ``q_dot`` (forward-mode JVP)."""
+    return jax.jvp(lambda qq: recursion_matrix(system, params, qq), (q,), (q_dot,))[1]
+
+
+def velocity_matrix_dot(system: System, params: SystemParams, q, q_dot) -> Float[Array, "nq ny"]:
+    """Time derivative of ``B T`` along ``q_dot`` (``pBdot`` combined with ``pTdot``)."""
+    return jax.jvp(lambda qq: velocity_matrix(system, params, qq), (q,), (q_dot,))[1]
+
+
 def constraint_jacobian(system: System, params: SystemParams, q, u=None) -> Float[Array, "m nq"]:
     """``Phi_q`` by forward-mode autodiff."""
     return jax.jacfwd(lambda qq: constraints(system, params, qq, u))(q)
