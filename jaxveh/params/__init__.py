@@ -25,4 +25,5 @@ from ._schema import (
     ParameterError as ParameterError,
     Quantity as Quantity,
     read_section as read_section,
+    read_toml as read_toml,
 )

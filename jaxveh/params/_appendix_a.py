@@ -1,14 +1,12 @@
 """Appendix A data set (chapter 3): the analytic vehicle, as an Equinox pytree in SI units."""
 
-import tomllib
-from importlib import resources
 from pathlib import Path
 
 import equinox as eqx
 from jaxtyping import Array, Float
 
 from ._fields import float_field
-from ._schema import ParameterError, Quantity, check_sections, read_section
+from ._schema import ParameterError, Quantity, check_sections, read_section, read_toml
 
 _TA1 = "Table A.1"
 _TYRE = "choice, docs/assumptions.md"
@@ -166,16 +164,5 @@ def analytic_vehicle_from_dict(table: dict, where: str = "<dict>") -> AnalyticVe
 
 def load_analytic_vehicle(path: str | Path | None = None) -> AnalyticVehicle:
     """Load an Appendix-A-style vehicle file (default: the shipped ``appendix_a.toml``)."""
-    if path is None:
-        text = resources.files("jaxveh.params").joinpath("data/appendix_a.toml").read_text()
-        where = "appendix_a.toml"
-    else:
-        path = Path(path)
-        if not path.is_file():
-            raise ParameterError(f"vehicle file {str(path)!r} does not exist")
-        text, where = path.read_text(), str(path)
-    try:
-        table = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ParameterError(f"{where}: not valid TOML ({e})") from None
+    table, where = read_toml(path, "jaxveh.params", "data/appendix_a.toml", "vehicle")
     return analytic_vehicle_from_dict(table, where)

@@ -1,7 +1,5 @@
 """Appendix B data set (chapters 6-7): the 14-DOF vehicle's general, mass and hard-point data."""
 
-import tomllib
-from importlib import resources
 from pathlib import Path
 
 import equinox as eqx
@@ -9,7 +7,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from ._fields import float_field
-from ._schema import ParameterError, Quantity, check_sections, read_section
+from ._schema import ParameterError, Quantity, check_sections, read_section, read_toml
 
 HARD_POINT_NAMES = ("A", "B", "C", "D", "E", "F", "H", "L", "M", "P", "Q", "R", "S", "T")
 #: Hard points on the sprung mass (chassis side) of each corner (section 6.2.2).
@@ -165,18 +163,7 @@ def vehicle_data_from_dict(table: dict, where: str = "<dict>") -> VehicleData:
 
 def load_vehicle_data(path: str | Path | None = None) -> VehicleData:
     """Load an Appendix-B-style vehicle file (default: the shipped ``appendix_b.toml``)."""
-    if path is None:
-        text = resources.files("jaxveh.params").joinpath("data/appendix_b.toml").read_text()
-        where = "appendix_b.toml"
-    else:
-        path = Path(path)
-        if not path.is_file():
-            raise ParameterError(f"vehicle file {str(path)!r} does not exist")
-        text, where = path.read_text(), str(path)
-    try:
-        table = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ParameterError(f"{where}: not valid TOML ({e})") from None
+    table, where = read_toml(path, "jaxveh.params", "data/appendix_b.toml", "vehicle")
     return vehicle_data_from_dict(table, where)
 
 
