@@ -26,7 +26,7 @@ TARGET_MASS = 23.5  # kg, thesis section 6.2.2
 TARGET_STIFFNESS = 385.0  # Nm/deg, FE value, thesis section 6.2.2
 TARGET_F1 = 38.35  # Hz, Table 6.4 mode 1
 BOUNDS_D = (15e-3, 35e-3)  # m
-BOUNDS_T = (0.9e-3, 3.0e-3)  # m, 0.9 mm: thinnest weldable chromoly wall in common use
+BOUNDS_T = (0.8e-3, 3.0e-3)  # m, 0.8 mm (0.032 in): thinnest common chromoly frame tube
 #: Minimum normalised x-centroid of mode-1 strain energy (-1 rear end, +1 front end): the
 #: automatic labels call a mode "front" beyond 0.25 (jaxveh.fe._labels.REGION_THRESHOLD).
 FRONT_CENTROID = 0.35
@@ -53,6 +53,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("results/fe_tune_frame"))
     ap.add_argument("--steps", type=int, default=300)
+    ap.add_argument("--lr", type=float, default=0.02, help="Adam learning rate (log-size units)")
     ap.add_argument("--frame", type=Path, default=None, help="frame TOML (default: shipped frame)")
     args = ap.parse_args()
     frame = fe.load_frame(args.frame)
@@ -71,7 +72,7 @@ def main():
         return miss + 10.0 * bound + reg, (m, k, f1, share)
 
     step_fn = eqx.filter_jit(jax.value_and_grad(loss, has_aux=True))
-    opt = optax.adam(0.02)
+    opt = optax.adam(args.lr)
     x = (logd0, logt0)
     state = opt.init(x)
     t0 = time.time()

@@ -47,7 +47,7 @@ def modes(
     frame: Path = FrameOpt,
     n: int = typer.Option(6, "--n", help="number of elastic modes"),
     method: str = typer.Option("truncation", "--method", help="truncation | craig-bampton"),
-    n_fixed: int = typer.Option(20, "--n-fixed", help="fixed-interface modes (craig-bampton)"),
+    n_fixed: int = typer.Option(60, "--n-fixed", help="fixed-interface modes (craig-bampton)"),
     json: bool = JsonOpt,
 ) -> None:
     """Lowest free-free elastic modes with automatic labels (thesis Table 6.4)."""
@@ -71,7 +71,7 @@ def modes(
 def compare(
     frame: Path = FrameOpt,
     n: int = typer.Option(20, "--n", help="number of modes compared"),
-    n_fixed: int = typer.Option(20, "--n-fixed", help="fixed-interface modes in the Craig-Bampton basis"),
+    n_fixed: int = typer.Option(60, "--n-fixed", help="fixed-interface modes in the Craig-Bampton basis"),
     json: bool = JsonOpt,
 ) -> None:
     """Modal truncation vs Craig-Bampton: NRFD and MAC (thesis Fig. 6.9)."""

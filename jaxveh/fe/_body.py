@@ -7,6 +7,7 @@ from jaxtyping import Array, Float
 
 from ..params import ParameterError
 from ._assembly import assemble, mesh_xyz
+from ._beam import CircularTube, Material
 from ._frame import Frame, frame_from_dict
 from ._invariants import ModalBody, modal_body
 from ._modal import free_free_modes
@@ -91,14 +92,24 @@ def straight_tube_frame(
             names.append("mid")
         else:
             names.append(f"n{k}")
+    for name, v in (("diameter", diameter), ("thickness", thickness), ("youngs_modulus", youngs_modulus),
+                    ("shear_modulus", shear_modulus), ("density", density)):
+        if isinstance(v, (int, float)) and not v > 0.0:
+            raise ParameterError(f"{name} = {v!r} is out of range: allowed > 0")
     table = {
         "frame": {"interface": ["start", "end"]},
-        "materials": {"steel": {"E": youngs_modulus / 1e9, "G": shear_modulus / 1e9, "density": density}},
-        "sections": {"tube": {"shape": "circular", "diameter": diameter * 1e3, "thickness": thickness * 1e3}},
+        "materials": {"steel": {"E": 210.0, "G": 80.0, "density": 7850.0}},
+        "sections": {"tube": {"shape": "circular", "diameter": 30.0, "thickness": 2.0}},
         "nodes": {n: [1e3 * length * k / n_elements, 0.0, 0.0] for k, n in enumerate(names)},
         "members": [{"nodes": [a, b], "section": "tube"} for a, b in zip(names[:-1], names[1:])],
     }
-    return frame_from_dict(table, "<straight tube>")
+    frame = frame_from_dict(table, "<straight tube>")
+    # sizes and material enter as leaves (they may be traced values)
+    return eqx.tree_at(
+        lambda f: (f.sections, f.materials),
+        frame,
+        ((CircularTube(diameter, thickness),), (Material(youngs_modulus, shear_modulus, density),)),
+    )
 
 
 def straight_beam_body(

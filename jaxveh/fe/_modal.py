@@ -31,7 +31,8 @@ N_RIGID = 6
 def safe_eigh(a: Float[Array, "n n"]) -> tuple[Float[Array, "n"], Float[Array, "n n"]]:
     """Eigenvalues (ascending) and orthonormal eigenvectors of symmetric ``a``,
     with finite derivatives at repeated eigenvalues (module docstring)."""
-    return jnp.linalg.eigh(a)
+    w, v = jnp.linalg.eigh(a)
+    return w, v
 
 
 @safe_eigh.defjvp

@@ -1,0 +1,133 @@
+"""Derivatives of frequencies, torsional stiffness and invariants w.r.t. tube sizes."""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from helpers import assert_grad_matches_fd
+from test_fe_reduction import box_frame
+
+import jaxveh.fe as fe
+
+#: Central differences with h = 1e-8 m on millimetre sizes: truncation O(h²) is
+#: negligible, round-off ~1e-16 f / h ~ 1e-7 relative: compare to 1e-5.
+RTOL_FD = 1e-5
+H_FD = 1e-8
+
+
+@pytest.fixture(scope="module")
+def frame():
+    return box_frame()
+
+
+def sized(frame, x):
+    """The box frame with section "tube" = CircularTube(x[0], x[1]) (m)."""
+    secs = list(frame.sections)
+    secs[0] = fe.CircularTube(x[0], x[1])
+    return fe.with_sections(frame, secs)
+
+
+X0 = np.array([25.4e-3, 1.6e-3])
+
+
+def first_frequencies(frame, x):
+    K, M = fe.assemble(sized(frame, x))
+    return fe.free_free_modes(K, M, 4)[0]
+
+
+def test_frequency_gradient_matches_fd(frame):
+    f = jax.jit(lambda x: first_frequencies(frame, x)[0])
+    assert_grad_matches_fd(f, X0, h=H_FD, rtol=RTOL_FD)
+    f3 = jax.jit(lambda x: first_frequencies(frame, x)[3])
+    assert_grad_matches_fd(f3, X0, h=H_FD, rtol=RTOL_FD)
+
+
+def test_frequency_forward_and_reverse_agree(frame):
+    f = lambda x: first_frequencies(frame, x)
+    J_fwd = jax.jacfwd(f)(jnp.asarray(X0))
+    J_rev = jax.jacrev(f)(jnp.asarray(X0))
+    np.testing.assert_allclose(J_fwd, J_rev, rtol=1e-10)
+
+
+def test_torsional_stiffness_gradient_matches_fd(frame):
+    k = jax.jit(lambda x: fe.torsion_test(sized(frame, x)).stiffness_nm_per_deg)
+    assert_grad_matches_fd(k, X0, h=H_FD, rtol=RTOL_FD)
+
+
+def test_mass_gradient_closed_form(frame):
+    """d(mass)/dt = rho L pi (D - 2t) summed over the members of that section."""
+    m = lambda x: fe.frame_mass(sized(frame, x))
+    g = jax.grad(m)(jnp.asarray(X0))
+    L = sum(
+        np.linalg.norm(np.diff(np.asarray(frame.node_xyz)[list(ij)], axis=0))
+        for ij, s in zip(frame.member_nodes, frame.member_section) if s == 0
+    )
+    np.testing.assert_allclose(g[1], 7850.0 * L * np.pi * (X0[0] - 2 * X0[1]), rtol=1e-12)
+    np.testing.assert_allclose(g[0], 7850.0 * L * np.pi * X0[1], rtol=1e-12)
+
+
+def test_invariant_gradients_match_fd(frame):
+    def inv(x):
+        body = fe.frame_modal_body(sized(frame, x), 3, points=("s0c0",))
+        i = body.invariants
+        # sign-invariant functions of mode-dependent invariants
+        return i.J0[0, 0] + jnp.sum(i.C4**2) + jnp.sum(i.C5**2) + 1e-6 * jnp.sum(body.Ke)
+
+    assert_grad_matches_fd(jax.jit(inv), X0, h=H_FD, rtol=RTOL_FD)
+
+
+def test_repeated_eigenvalues_give_finite_exact_cluster_gradient():
+    """A circular tube has equal bending frequencies in y and z: per-mode derivatives
+    are finite and the pair's sum is exact."""
+    def pair(x):
+        tube = fe.straight_tube_frame(1.0, 8, x[0], x[1])
+        K, M = fe.assemble(tube)
+        return fe.free_free_modes(K, M, 2)[0]
+
+    x = jnp.asarray([30e-3, 2e-3])
+    f = pair(x)
+    np.testing.assert_allclose(f[0], f[1], rtol=1e-9)
+    g = jax.jacrev(pair)(x)
+    assert np.all(np.isfinite(g))
+    assert_grad_matches_fd(jax.jit(lambda x: jnp.sum(pair(x))), x, h=H_FD, rtol=RTOL_FD)
+
+
+def test_vmap_of_grad(frame):
+    g = jax.jit(jax.vmap(jax.grad(lambda x: first_frequencies(frame, x)[0])))
+    xs = jnp.stack([jnp.asarray(X0), jnp.asarray(X0) * 1.1])
+    out = g(xs)
+    np.testing.assert_allclose(out[0], jax.grad(lambda x: first_frequencies(frame, x)[0])(jnp.asarray(X0)), rtol=1e-10)
+    assert not np.allclose(out[0], out[1])
+
+
+def test_no_retrace_on_new_sizes(frame):
+    @eqx.filter_jit
+    @eqx.debug.assert_max_traces(max_traces=1)
+    def freq(fr):
+        K, M = fe.assemble(fr)
+        return fe.free_free_modes(K, M, 2)[0]
+
+    a = freq(sized(frame, jnp.asarray(X0)))
+    b = freq(sized(frame, jnp.asarray(X0) * 1.05))
+    assert not np.allclose(a, b)
+
+
+def test_gradient_wrt_node_coordinates_and_material(frame):
+    """Torsional stiffness w.r.t. the height of one mid-station node and Young's modulus."""
+    k0 = fe.torsion_test(frame).stiffness
+    j = frame.node_index("s1c2")
+
+    def k_of(x):
+        xyz = frame.node_xyz.at[j, 2].set(x[0])
+        mat = fe.Material(x[1], frame.materials[0].shear_modulus, frame.materials[0].density)
+        fr = eqx.tree_at(lambda f: (f.node_xyz, f.materials), frame, (xyz, (mat,)))
+        return fe.torsion_test(fr).stiffness / k0
+
+    x0 = np.array([float(frame.node_xyz[j, 2]), float(frame.materials[0].youngs_modulus)])
+    g = jax.grad(jax.jit(k_of))(jnp.asarray(x0))
+    fd = [
+        (float(k_of(jnp.asarray(x0 + dx))) - float(k_of(jnp.asarray(x0 - dx)))) / (2 * dx[i])
+        for i, dx in enumerate((np.array([1e-6, 0.0]), np.array([0.0, 1e8])))
+    ]
+    np.testing.assert_allclose(g, fd, rtol=1e-5)
