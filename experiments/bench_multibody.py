@@ -46,6 +46,55 @@ def cases():
     q, z = ex.flexible_pendulum_state(s, 0.3, (1e-4, -1e-4))
     q = mb.assemble(s, p, q, fixed=(5, 6, 7))
     yield "flexible pendulum (2 modes)", s, p, q, z.at[0].set(1.0), None
+    s, p, q = vehicle_scale_system()
+    rack = lambda t: jnp.reshape(0.0 * t, (1,))  # noqa: E731
+    mb.check_rank(s, p, q, inputs=rack)
+    z = jnp.zeros(s.n_dof).at[jnp.asarray([s.independent.index(s.y_index("chassis", "ux"))])].set(10.0)
+    yield "vehicle topology (9 bodies, 6 modes)", s, p, q, z, rack
+
+
+def vehicle_scale_system():
+    """A system with the 14-DOF vehicle's topology (section 6.1): FE chassis (6 modes) as a
+    free modal body, four uprights on five links each (Table 6.3) with the Appendix B hard
+    points, four wheels on tree revolute joints, a rack input moving both front L points.
+    9 bodies, 20 link constraints, 20 independent velocities. Benchmark only: the vehicle
+    itself (springs, tyres, rockers) is built elsewhere."""
+    from jaxveh import fe
+    from jaxveh.params import HARD_POINT_NAMES, hard_points_vehicle_frame, load_vehicle_data
+
+    data = load_vehicle_data()
+    hp = hard_points_vehicle_frame(data)
+    modal = fe.frame_modal_body(fe.load_frame(), 6, beta=0.01)
+    b = mb.SystemBuilder()
+    b.add_input("rack")
+    b.add_flexible_body("chassis", modal)
+    q = [jnp.zeros(12)]
+    for corner, pts in hp.items():
+        pts = np.asarray(pts)
+        front = corner.startswith("front")
+        track = float(data.track_front if front else data.track_rear)
+        x = float(data.a) if front else -float(data.b)
+        w = np.array([x, track / 2 * (1 if corner.endswith("left") else -1), ex.WHEEL_CENTRE_HEIGHT])
+        ub = data.unsprung_front if front else data.unsprung_rear
+        up, wh = f"{corner}.upright", f"{corner}.wheel"
+        b.add_rigid_body(up, float(ub.body.mass), np.asarray(ub.body.inertia), parent="chassis", rotation="zxy")
+        b.add_rigid_body(wh, 0.0, np.diag([0.0, float(ub.wheel_spin_inertia), 0.0]), parent=up,
+                         revolute=((0, 0, 0), (0, 1, 0)))
+        for n in ("A", "B", "E", "F", "L"):
+            kw = {"input": "rack", "input_direction": (0.0, 1.0, 0.0)} if (n == "L" and front) else {}
+            b.add_modal_point(f"{corner}.{n}", "chassis", f"{corner}.{n}", **kw)
+        for n in ("C", "H", "M"):
+            b.add_point(f"{corner}.{n}", up, pts[HARD_POINT_NAMES.index(n)] - w)
+        for link, pa, pq in ex.QUARTER_CAR_LINKS:
+            length = np.linalg.norm(pts[HARD_POINT_NAMES.index(pa)] - pts[HARD_POINT_NAMES.index(pq)])
+            b.add_link(f"{corner}.{link}", f"{corner}.{pa}", f"{corner}.{pq}", length)
+        b.add_independent(up, "uz")
+        b.add_independent(wh, "theta_dot")
+        q += [jnp.concatenate([jnp.asarray(w), jnp.zeros(3)]), jnp.zeros(1)]
+    for name in ("ux", "uy", "uz", "wx", "wy", "wz") + tuple(f"p{k}_dot" for k in range(6)):
+        b.add_independent("chassis", name)
+    system, params = b.build()
+    return system, params, jnp.concatenate(q)
 
 
 def bench_vector_fields():

@@ -43,14 +43,15 @@ def gradients(system, params):
     q, _ = ex.quarter_car_kinematics(system, params, 0.0, 0.0)
     inputs = lambda t: jnp.reshape(t, (1,))  # noqa: E731  unit rack rate at rack = 0
     proj = mb.projection(system, params, q, 0.0, inputs)
+    bt = mb.velocity_matrix(system, params, q)
 
     def outputs(qq):
         camber, toe = ex.wheel_angles(system, params, qq)
         return jnp.stack([camber * DEG, toe * DEG, 2.0 * qq[1] * 1e3, qq[0] * 1e3])
 
-    bump_col = proj.BT @ proj.R[:, 0]
+    bump_col = bt @ proj.R[:, 0]
     g_bump = np.asarray(jax.jvp(outputs, (q,), (bump_col,))[1]) / float(bump_col[2]) * 1e-3  # per mm
-    g_rack = np.asarray(jax.jvp(outputs, (q,), (proj.BT @ proj.Sb,))[1]) * 1e-3
+    g_rack = np.asarray(jax.jvp(outputs, (q,), (bt @ proj.Sb,))[1]) * 1e-3
 
     kin = jax.jit(lambda b, r: outputs(ex.quarter_car_kinematics(system, params, b, r)[0]))
     h = 1e-5

@@ -59,7 +59,8 @@ def test_constraints_velocity_and_projection_identities():
     system, params = ex.double_pendulum()
     q, z = ex.double_pendulum_state(system, params, (0.4, 0.9), (1.3, -0.7))
     proj = mb.projection(system, params, q)
-    phi_y = proj.phi_q @ proj.BT
+    phi_y = mb.constraint_jacobian(system, params, q) @ mb.velocity_matrix(system, params, q)
+    np.testing.assert_allclose(proj.phi_y, phi_y, atol=1e-14)  # explicit rates == autodiff Phi_q B T
     np.testing.assert_allclose(proj.phi, 0.0, atol=1e-15)
     # eq. (5.56): Phi_q B T R = 0 and P R = I
     np.testing.assert_allclose(phi_y @ proj.R, 0.0, atol=1e-13)

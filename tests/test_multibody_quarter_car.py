@@ -53,14 +53,15 @@ def _gradients_from_r(system, params, q, rack):
     """d(outputs)/d(wheel-centre z) and d(outputs)/d(rack) from R and S b (section 7.1.3)."""
     inputs = lambda t: jnp.reshape(rack + t, (1,))  # unit rack rate  # noqa: E731
     proj = mb.projection(system, params, q, 0.0, inputs)
+    bt = mb.velocity_matrix(system, params, q)
 
     def outputs(qq):
         camber, toe = ex.wheel_angles(system, params, qq)
         return jnp.stack([camber, toe, 2.0 * qq[1], qq[0]])
 
-    dq_ds = proj.BT @ proj.R[:, 0]  # unit independent bump velocity (upright body uz)
+    dq_ds = bt @ proj.R[:, 0]  # unit independent bump velocity (upright body uz)
     d_bump = jax.jvp(outputs, (q,), (dq_ds,))[1] / dq_ds[2]  # per unit global wheel-centre z
-    d_rack = jax.jvp(outputs, (q,), (proj.BT @ proj.Sb,))[1]  # at z = 0: bump and spin held
+    d_rack = jax.jvp(outputs, (q,), (bt @ proj.Sb,))[1]  # at z = 0: bump and spin held
     return d_bump, d_rack
 
 

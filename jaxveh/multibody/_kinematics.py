@@ -117,6 +117,54 @@ def _point_rotation(system: System, poses, k: int):
     return jnp.eye(3, dtype=poses[0][0].dtype) if body < 0 else poses[body][1]
 
 
+def _solve3(m, b):
+    """``m^-1 b`` for a 3 x 3 matrix by the adjugate (cheap elementwise ops, no LU call)."""
+    c0, c1, c2 = m[:, 0], m[:, 1], m[:, 2]
+    adj = jnp.stack([jnp.cross(c1, c2), jnp.cross(c2, c0), jnp.cross(c0, c1)])
+    return (adj @ b) / jnp.dot(c0, jnp.cross(c1, c2))
+
+
+def _point_velocity_v(system: System, params: SystemParams, poses, vs, k: int, u):
+    """Global velocity of point ``k`` from the body velocities ``vs`` (linear in ``vs``;
+    input rates excluded, they enter through ``Phi_t``)."""
+    body = system.point_body[k]
+    if body < 0:
+        return jnp.zeros((3,), vs[0].dtype)
+    x = point_local(system, params, poses, k, u)
+    v = vs[body]
+    local = v[:3] + jnp.cross(v[3:6], x)
+    if system.n_modes[body] > 0:
+        local = local + params.bodies[body].coupling * (params.points[k].shapes @ v[6:])
+    return poses[body][1] @ local
+
+
+def constraint_rates(system: System, params: SystemParams, poses, vs, u) -> Float[Array, " m"]:
+    """``Phi_q q_dot`` written explicitly in the body velocities (``Phi_q B`` applied to ``v``):
+    linear in ``vs``, so its Jacobian needs no derivative of the rotation matrices."""
+    rows = []
+    for k, kind in enumerate(system.joint_kind):
+        i, j = system.joint_points[k]
+        dv = _point_velocity_v(system, params, poses, vs, i, u) - _point_velocity_v(system, params, poses, vs, j, u)
+        jp = params.joints[k]
+        if kind == "spherical":
+            rows.append(jnp.stack([dv[c] for c in system.joint_components[k]]))
+        elif kind == "link":
+            d = point_position(system, params, poses, i, u) - point_position(system, params, poses, j, u)
+            rows.append(jnp.reshape(d @ dv / jp.length, (1,)))
+        else:
+            bi, bj = system.point_body[i], system.point_body[j]
+            ai, aj = _point_rotation(system, poses, i), _point_rotation(system, poses, j)
+            wi = jnp.zeros((3,), dv.dtype) if bi < 0 else vs[bi][3:6]
+            wj = jnp.zeros((3,), dv.dtype) if bj < 0 else vs[bj][3:6]
+            n2, n3 = _orthonormal_pair(jp.axis_i)
+            n1j, dn1j = aj @ jp.axis_j, aj @ jnp.cross(wj, jp.axis_j)
+            rate = [(ai @ jnp.cross(wi, n)) @ n1j + (ai @ n) @ dn1j for n in (n2, n3)]
+            rows.append(jnp.concatenate([dv, jnp.stack(rate)]))
+    if not rows:
+        return jnp.zeros((0,), vs[0].dtype)
+    return jnp.concatenate(rows)
+
+
 def body_velocities(system: System, params: SystemParams, q, y, poses=None) -> list:
     """``v = T y`` (eq. 5.49): body-frame velocities ``[u, omega, p_dot]`` of every body."""
     poses = body_poses(system, params, q) if poses is None else poses
@@ -153,7 +201,7 @@ def qdot_from_velocities(system: System, params: SystemParams, q, y, vs, poses) 
             _, a, _ = poses[i]
             qi = q[system.q_offsets[i] : system.q_offsets[i] + 6]
             gr = angular_velocity_matrix(system.sequence[i], qi[3:6])
-            out.append(jnp.concatenate([a @ vs[i][:3], jnp.linalg.solve(gr, vs[i][3:6]), vs[i][6:]]))
+            out.append(jnp.concatenate([a @ vs[i][:3], _solve3(gr, vs[i][3:6]), vs[i][6:]]))
         else:
             out.append(ys[i])
     return jnp.concatenate(out)

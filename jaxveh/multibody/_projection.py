@@ -20,7 +20,7 @@ from jaxtyping import Array, Float
 
 from ._dynamics import internal_forces, mass_matrix
 from ._errors import RedundantConstraintError, SingularMassMatrixError
-from ._kinematics import constraints, velocity_maps
+from ._kinematics import body_poses, body_velocities, constraint_rates, constraints, qdot_from_velocities
 from ._system import System, SystemParams
 
 Inputs = Callable[[Float[Array, ""]], Float[Array, " ni"]]
@@ -43,56 +43,88 @@ def _phi_of(system, params, inputs):
     return phi
 
 
-def _selection(system: System, dtype) -> Float[Array, "ndof ny"]:
-    """``P`` of eq. (5.52): the boolean matrix that extracts the independent velocities."""
-    return jnp.asarray(np.eye(system.n_y)[list(system.independent)], dtype=dtype)
-
-
 class Projection(eqx.Module):
     """Kinematic quantities at one state (thesis Table 5.3 and eqs. 5.54-5.62).
 
-    ``phi`` constraint residuals, ``phi_q`` their Jacobian, ``T`` recursion matrix,
-    ``BT`` with ``q_dot = B T y``, ``R`` projection (null-space) matrix, ``Sb`` particular
-    velocity solution, ``lu`` the LU factors of ``[Phi_q B T; P]``.
+    ``phi`` constraint residuals, ``phi_y = Phi_q B T``, ``T`` recursion matrix, ``R``
+    projection (null-space) matrix, ``Sb`` particular velocity solution, ``lu`` the LU
+    factors of the dependent-velocity block of ``Phi_q B T`` (see :func:`solve_s`).
+    ``B T`` itself: :func:`velocity_matrix`.
     """
 
     phi: Float[Array, " m"]
-    phi_q: Float[Array, "m nq"]
+    phi_y: Float[Array, "m ny"]
     T: Float[Array, "nv ny"]
-    BT: Float[Array, "nq ny"]
     R: Float[Array, "ny ndof"]
     Sb: Float[Array, " ny"]
     lu: tuple
 
 
 def _jacobians(system, params, q, t, inputs):
-    """``Phi``, ``Phi_t``, ``Phi_q``, ``T`` and ``B T`` at ``(q, t)``."""
+    """``Phi``, ``Phi_t``, ``T`` and ``Phi_q B T`` at ``(q, t)``.
+
+    ``Phi_q B T`` is the Jacobian of the explicit constraint rates (linear in the body
+    velocities) composed with the recursion, so only one forward pass with ``n_y`` tangents
+    through cheap linear maps is needed; the rotation matrices are not differentiated.
+    """
     phi_fn = _phi_of(system, params, inputs)
     phi, phi_t = jax.jvp(lambda tt: phi_fn(q, tt), (t,), (jnp.ones_like(t),))
-    phi_q = jax.jacfwd(phi_fn)(q, t)
-    t_mat, bt = jax.jacfwd(lambda y: velocity_maps(system, params, q, y))(jnp.zeros((system.n_y,), q.dtype))
-    return phi, phi_t, phi_q, t_mat, bt
+    u = input_values(system, inputs, t, q.dtype)
+    poses = body_poses(system, params, q)
+
+    def linear(y):
+        vs = body_velocities(system, params, q, y, poses)
+        return jnp.concatenate(vs), constraint_rates(system, params, poses, vs, u)
+
+    t_mat, phi_y = jax.jacfwd(linear)(jnp.zeros((system.n_y,), q.dtype))
+    return phi, phi_t, t_mat, phi_y
+
+
+def _dependent(system: System) -> tuple[int, ...]:
+    """Joint velocities not declared independent (static)."""
+    chosen = set(system.independent)
+    return tuple(k for k in range(system.n_y) if k not in chosen)
+
+
+def _scatter(system: System, dep_part, ind_part):
+    """Assemble a vector / matrix over ``y`` from its dependent and independent rows."""
+    shape = (system.n_y,) + dep_part.shape[1:]
+    out = jnp.zeros(shape, dep_part.dtype).at[jnp.asarray(_dependent(system), dtype=int)].set(dep_part)
+    return out.at[jnp.asarray(system.independent, dtype=int)].set(ind_part)
+
+
+def solve_s(system: System, lu, rhs):
+    """``S rhs``: the particular solution of ``[Phi_q B T; P] y = [rhs; 0]``."""
+    dep = jax.scipy.linalg.lu_solve(lu, rhs)
+    return _scatter(system, dep, jnp.zeros((system.n_dof,) + rhs.shape[1:], rhs.dtype))
 
 
 def projection(
     system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, kappa=0.0
 ) -> Projection:
-    """Constraint Jacobians, ``T``, ``B T`` and the projection ``R``, ``S b`` (eq. 5.54)."""
+    """Constraint residuals, ``T``, ``Phi_q B T`` and the projection ``R``, ``S b`` (eq. 5.54).
+
+    ``P`` is boolean (eq. 5.52), so ``[Phi_q B T; P]`` is solved by partitioning ``y`` into
+    dependent and independent velocities: only the square block ``Phi_d`` of the dependent
+    columns is LU-factorised (``m x m`` instead of ``n_y x n_y``) and reused for ``R``,
+    ``S b``, ``S c`` and the multipliers. ``R`` and ``S`` are exactly those of eq. (5.55).
+    """
     t = jnp.asarray(t, q.dtype)
-    phi, phi_t, phi_q, t_mat, bt = _jacobians(system, params, q, t, inputs)
-    m, ndof = system.n_constraints, system.n_dof
-    a = jnp.concatenate([phi_q @ bt, _selection(system, q.dtype)])
-    lu = jax.scipy.linalg.lu_factor(a)
+    phi, phi_t, t_mat, phi_y = _jacobians(system, params, q, t, inputs)
+    phi_d = phi_y[:, jnp.asarray(_dependent(system), dtype=int)]
+    phi_i = phi_y[:, jnp.asarray(system.independent, dtype=int)]
+    lu = jax.scipy.linalg.lu_factor(phi_d)
     b = -phi_t - kappa * phi
-    rhs = jnp.block([[b[:, None], jnp.zeros((m, ndof), q.dtype)], [jnp.zeros((ndof, 1), q.dtype), jnp.eye(ndof)]])
-    sol = jax.scipy.linalg.lu_solve(lu, rhs)
+    sol = jax.scipy.linalg.lu_solve(lu, jnp.concatenate([b[:, None], -phi_i], axis=1))
     sol = eqx.error_if(
         sol,
         ~jnp.all(jnp.isfinite(sol)),
         "[Phi_q B T; P] is singular: redundant constraints or dependent independent velocities "
         "(call jaxveh.multibody.check_rank at this state for the names)",
     )
-    return Projection(phi=phi, phi_q=phi_q, T=t_mat, BT=bt, R=sol[:, 1:], Sb=sol[:, 0], lu=lu)
+    zeros = jnp.zeros((system.n_dof,), q.dtype)
+    r = _scatter(system, sol[:, 1:], jnp.eye(system.n_dof, dtype=q.dtype))
+    return Projection(phi=phi, phi_y=phi_y, T=t_mat, R=r, Sb=_scatter(system, sol[:, 0], zeros), lu=lu)
 
 
 def _velocity_constraint(system, params, inputs, y, kappa):
@@ -100,9 +132,11 @@ def _velocity_constraint(system, params, inputs, y, kappa):
     phi_fn = _phi_of(system, params, inputs)
 
     def h(q, t):
-        q_dot = velocity_maps(system, params, q, y)[1]
-        phi, phi_dot = jax.jvp(phi_fn, (q, t), (q_dot, jnp.ones_like(t)))
-        return phi_dot + kappa * phi
+        u = input_values(system, inputs, t, q.dtype)
+        poses = body_poses(system, params, q)
+        vs = body_velocities(system, params, q, y, poses)
+        phi, phi_t = jax.jvp(lambda tt: phi_fn(q, tt), (t,), (jnp.ones_like(t),))
+        return constraint_rates(system, params, poses, vs, u) + phi_t + kappa * phi
 
     return h
 
@@ -113,7 +147,9 @@ class Dynamics(eqx.Module):
     ``y`` joint velocities, ``v`` body velocities, ``q_dot``, ``z_dot`` independent
     accelerations, ``mass_matrix`` the reduced ``R^T T^T M T R``, ``internal_forces`` the
     reduced velocity/elastic/damping forces ``R^T T^T (Q_v + Q_e - M (T_dot y + T S c))``,
-    ``external_forces`` the reduced gravity + applied forces, ``y_dot``, ``v_dot``, ``Sc``.
+    ``external_forces`` the reduced gravity + applied forces, ``y_dot``, ``v_dot``, ``Sc``,
+    ``multipliers`` (see :func:`multipliers`). Under ``jit`` whatever the caller does not use
+    is removed by dead-code elimination.
     """
 
     projection: Projection
@@ -127,8 +163,7 @@ class Dynamics(eqx.Module):
     mass_matrix: Float[Array, "ndof ndof"]
     internal_forces: Float[Array, " ndof"]
     external_forces: Float[Array, " ndof"]
-    full_mass_matrix: Float[Array, "nv nv"]
-    forces: Float[Array, " nv"]
+    multipliers: Float[Array, " m"]
 
 
 def dynamics(
@@ -150,12 +185,14 @@ def dynamics(
     t = jnp.asarray(t, q.dtype)
     proj = projection(system, params, q, t, inputs, kappa)
     y = proj.R @ z + proj.Sb
-    v, q_dot = proj.T @ y, proj.BT @ y
+    poses = body_poses(system, params, q)
+    vs = body_velocities(system, params, q, y, poses)
+    v = jnp.concatenate(vs)
+    q_dot = qdot_from_velocities(system, params, q, y, vs, poses)
     h = _velocity_constraint(system, params, inputs, y, kappa)
     c = -jax.jvp(h, (q, t), (q_dot, jnp.ones_like(t)))[1]
-    rhs_c = jnp.concatenate([c, jnp.zeros((system.n_dof,), q.dtype)])
-    sc = jax.scipy.linalg.lu_solve(proj.lu, rhs_c)
-    t_dot_y = jax.jvp(lambda qq: velocity_maps(system, params, qq, y)[0], (q,), (q_dot,))[1]
+    sc = solve_s(system, proj.lu, c)
+    t_dot_y = jax.jvp(lambda qq: jnp.concatenate(body_velocities(system, params, qq, y)), (q,), (q_dot,))[1]
     a0 = proj.T @ sc + t_dot_y  # body accelerations at z_dot = 0
     tr = proj.T @ proj.R
     m_full = mass_matrix(system, params, q)
@@ -168,24 +205,26 @@ def dynamics(
     chol = eqx.error_if(
         chol,
         ~jnp.all(jnp.isfinite(chol)),
-        "reduced mass matrix R^T T^T M T R is singular or not positive definite",
+        "reduced mass matrix R^T T^T M T R is singular or not positive definite "
+        "(call jaxveh.multibody.check_mass_matrix at this state for the names)",
     )
     z_dot = jax.scipy.linalg.cho_solve((chol, True), f_int + f_ext)
-    y_dot = proj.R @ z_dot + sc
+    v_dot = tr @ z_dot + a0
+    resid = proj.T.T @ (q_int + q_ext - m_full @ v_dot)
+    lam = jax.scipy.linalg.lu_solve(proj.lu, resid[jnp.asarray(_dependent(system), dtype=int)], trans=1)
     return Dynamics(
         projection=proj,
         y=y,
         v=v,
         q_dot=q_dot,
         z_dot=z_dot,
-        y_dot=y_dot,
-        v_dot=tr @ z_dot + a0,
+        y_dot=proj.R @ z_dot + sc,
+        v_dot=v_dot,
         Sc=sc,
         mass_matrix=m_red,
         internal_forces=f_int,
         external_forces=f_ext,
-        full_mass_matrix=m_full,
-        forces=q_int + q_ext,
+        multipliers=lam,
     )
 
 
@@ -193,20 +232,20 @@ def multipliers(system: System, dyn: Dynamics) -> Float[Array, " m"]:
     """Lagrange multipliers ``lambda = S^T T^T (Q - M v_dot)`` (thesis after eq. 5.61).
 
     Convention: ``T^T M v_dot + (Phi_q B T)^T lambda = T^T Q``. The generalised constraint
-    force on the bodies is ``-(d Phi / d x)^T lambda``: for a link, ``lambda`` is its tension
-    (N, positive pulls the two points together); for a spherical joint, ``-lambda`` is the
-    force (N, global axes) on the first point's body.
+    force on the body of a joint's second point is ``+(d Phi / d x)^T lambda``, on the
+    first point's body ``-(d Phi / d x)^T lambda``: for a link, ``lambda`` is its tension
+    (N, positive pulls the two points together); for a spherical joint, ``lambda`` is the
+    force (N, global axes) on the second point's body.
     """
-    resid = dyn.projection.T.T @ (dyn.forces - dyn.full_mass_matrix @ dyn.v_dot)
-    return jax.scipy.linalg.lu_solve(dyn.projection.lu, resid, trans=1)[: system.n_constraints]
+    del system
+    return dyn.multipliers
 
 
 def check_rank(system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, tol=1e-9) -> None:
     """Raise :class:`RedundantConstraintError` naming the joints or velocities at fault when
     ``[Phi_q B T; P]`` loses rank at ``q`` (Python-level check on concrete values)."""
     q = jnp.asarray(q, jnp.float64)
-    _, _, phi_q, _, bt = _jacobians(system, params, q, jnp.asarray(t, q.dtype), inputs)
-    phi_y = np.asarray(phi_q @ bt)
+    phi_y = np.asarray(_jacobians(system, params, q, jnp.asarray(t, q.dtype), inputs)[3])
     names_c, names_y = system.constraint_names, system.y_names
     if phi_y.shape[0] > 0:
         u, s, _ = np.linalg.svd(phi_y)
