@@ -17,7 +17,8 @@ axial                   (P_k, 0, 0)                              stretching alon
 
 (y, z measured from the centre of mass, in m). The family whose fitted part carries most of
 the mode's kinetic energy names the mode; if no family explains at least
-:data:`LOCAL_SHARE` of it the mode is "local". A "front" or "rear" prefix is added when the
+:data:`LOCAL_SHARE` of it the mode is "local", followed by the name of the user node
+nearest to the largest nodal translation (e.g. ``local (main_hoop_top_left)``). A "front" or "rear" prefix is added when the
 elastic strain energy is concentrated in that end: its x-centroid lies beyond
 :data:`REGION_THRESHOLD` of the half length from the middle.
 """
@@ -71,7 +72,12 @@ def family_shares(xyz: np.ndarray, mass: np.ndarray, u: np.ndarray) -> dict[str,
 
 
 def label_mode(
-    xyz: np.ndarray, mass: np.ndarray, u: np.ndarray, element_energy: np.ndarray, element_x: np.ndarray
+    xyz: np.ndarray,
+    mass: np.ndarray,
+    u: np.ndarray,
+    element_energy: np.ndarray,
+    element_x: np.ndarray,
+    node_names: tuple[str, ...] = (),
 ) -> str:
     """Description of one mode.
 
@@ -81,11 +87,17 @@ def label_mode(
         u: nodal translations of the mode, (n, 3).
         element_energy: strain energy of every element in the mode (J), (e,).
         element_x: x coordinate of every element centre (m), (e,).
+        node_names: names of the first ``len(node_names)`` nodes (the user nodes), used
+            to locate local modes.
     """
     shares = family_shares(xyz, mass, u)
     fam = max(shares, key=shares.get)
     if shares[fam] < LOCAL_SHARE:
-        return "local"
+        if not node_names:
+            return "local"
+        peak = xyz[np.argmax(np.sum(u * u, axis=1))]
+        near = np.argmin(np.sum((xyz[: len(node_names)] - peak) ** 2, axis=1))
+        return f"local ({node_names[near]})"
     x0, x1 = xyz[:, 0].min(), xyz[:, 0].max()
     xe = (2.0 * np.sum(element_energy * element_x) / np.sum(element_energy) - x0 - x1) / (x1 - x0)
     if xe > REGION_THRESHOLD:
