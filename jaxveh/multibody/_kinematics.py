@@ -7,6 +7,7 @@ topology and are unrolled once at trace time.
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array, Float
 
 from ._rotations import angular_velocity_matrix, axis_angle, rotation_matrix
@@ -61,13 +62,72 @@ def point_position(system: System, params: SystemParams, poses, k: int, u) -> Fl
     return r + a @ x
 
 
+def _frames(poses, dtype):
+    """Stacked origins ``(nb + 1, 3)`` and rotations ``(nb + 1, 3, 3)``; row 0 is the ground."""
+    rs = jnp.stack([jnp.zeros((3,), dtype)] + [p[0] for p in poses])
+    rots = jnp.stack([jnp.eye(3, dtype=dtype)] + [p[1] for p in poses])
+    return rs, rots
+
+
+def _body_rows(system: System):
+    """Static row of every point's body in the stacked frames (ground = 0)."""
+    return np.asarray(system.point_body, dtype=int) + 1
+
+
+def _points_on(system: System, body: int) -> list[int]:
+    return [k for k, b in enumerate(system.point_body) if b == body]
+
+
+def _add_modal(system: System, params: SystemParams, x, modal_values):
+    """``x[k] += coupling * Psi_k @ modal_values[body(k)]`` for points on flexible bodies."""
+    for b in range(system.n_bodies):
+        idx = _points_on(system, b)
+        if system.n_modes[b] == 0 or not idx:
+            continue
+        shapes = jnp.stack([params.points[k].shapes for k in idx])
+        x = x.at[np.asarray(idx)].add(params.bodies[b].coupling * jnp.einsum("kim,m->ki", shapes, modal_values[b]))
+    return x
+
+
+def points_local(system: System, params: SystemParams, poses, u) -> Float[Array, "np 3"]:
+    """Body-frame positions of all points with deformation and inputs (m), vectorised."""
+    x = jnp.stack([pt.position for pt in params.points])
+    x = _add_modal(system, params, x, [p[2] for p in poses])
+    idx = [k for k, i in enumerate(system.point_input) if i >= 0]
+    if idx:
+        dirs = jnp.stack([params.points[k].input_direction for k in idx])
+        vals = u[np.asarray([system.point_input[k] for k in idx])]
+        x = x.at[np.asarray(idx)].add(vals[:, None] * dirs)
+    return x
+
+
+def points_global(system: System, frames, local) -> Float[Array, "np 3"]:
+    """Global positions (m) of all points from their body-frame positions."""
+    rs, rots = frames
+    rows = _body_rows(system)
+    return rs[rows] + jnp.einsum("kij,kj->ki", rots[rows], local)
+
+
+def points_velocity(system: System, params: SystemParams, frames, vs, local) -> Float[Array, "np 3"]:
+    """Global velocities (m/s) of all points from the body velocities (linear in ``vs``;
+    input rates excluded, they enter through ``Phi_t``)."""
+    _, rots = frames
+    zero = jnp.zeros((3,), local.dtype)
+    us = jnp.stack([zero] + [v[:3] for v in vs])
+    ws = jnp.stack([zero] + [v[3:6] for v in vs])
+    rows = _body_rows(system)
+    rel = us[rows] + jnp.cross(ws[rows], local)
+    rel = _add_modal(system, params, rel, [v[6:] for v in vs])
+    return jnp.einsum("kij,kj->ki", rots[rows], rel)
+
+
 def marker_positions(system: System, params: SystemParams, q, u=None) -> Float[Array, "np 3"]:
     """``pX``: global positions (m) of all points, one row per point."""
-    poses = body_poses(system, params, q)
-    u = _inputs_or_empty(u, q.dtype)
     if not system.point_names:
         return jnp.zeros((0, 3), q.dtype)
-    return jnp.stack([point_position(system, params, poses, k, u) for k in range(len(system.point_names))])
+    poses = body_poses(system, params, q)
+    u = _inputs_or_empty(u, q.dtype)
+    return points_global(system, _frames(poses, q.dtype), points_local(system, params, poses, u))
 
 
 def body_rotation(system: System, params: SystemParams, q, body: str) -> Float[Array, "3 3"]:
@@ -85,31 +145,63 @@ def _orthonormal_pair(n1):
     return n2, jnp.cross(n1, n2)
 
 
+def _joint_layout(system: System):
+    """Static layout: point indices of every joint, link joints, spherical (joint, component)
+    pairs, revolute joints, and the permutation that puts the kind-grouped rows in joint
+    order (the order of :attr:`System.constraint_names`)."""
+    p_idx = np.asarray([jp[0] for jp in system.joint_points], dtype=int)
+    q_idx = np.asarray([jp[1] for jp in system.joint_points], dtype=int)
+    links = [k for k, kind in enumerate(system.joint_kind) if kind == "link"]
+    sph = [(k, c) for k, kind in enumerate(system.joint_kind) if kind == "spherical" for c in system.joint_components[k]]
+    revs = [k for k, kind in enumerate(system.joint_kind) if kind == "revolute"]
+    grouped = [(k, 0) for k in links] + sph + [(k, r) for k in revs for r in range(5)]
+    ordered = [(k, c) for k, kind in enumerate(system.joint_kind) for c in (
+        (0,) if kind == "link" else system.joint_components[k] if kind == "spherical" else range(5))]
+    perm = np.asarray([grouped.index(key) for key in ordered], dtype=int)
+    return p_idx, q_idx, links, sph, revs, perm
+
+
+def _assemble_rows(system, d_rows_links, sph_rows, rev_rows, dtype):
+    _, _, _, _, _, perm = _joint_layout(system)
+    pieces = [r for r in (d_rows_links, sph_rows) if r is not None] + rev_rows
+    if not pieces:
+        return jnp.zeros((0,), dtype)
+    return jnp.concatenate(pieces)[perm]
+
+
+def _sph_rows(sph, d):
+    if not sph:
+        return None
+    return d[np.asarray([k for k, _ in sph]), np.asarray([c for _, c in sph])]
+
+
 def constraints(system: System, params: SystemParams, q, u=None) -> Float[Array, " m"]:
     """``pPhi``: constraint residuals (eqs. 5.15-5.17), m for positions, dimensionless for axes.
 
     Link rows use ``(|d|^2 - l^2) / (2 l)``, equal to ``|d| - l`` to first order and smooth.
+    Vectorised over joints (one gather per joint kind).
     """
+    if system.n_constraints == 0:
+        return jnp.zeros((0,), q.dtype)
     poses = body_poses(system, params, q)
     u = _inputs_or_empty(u, q.dtype)
-    rows = []
-    for k, kind in enumerate(system.joint_kind):
+    x = points_global(system, _frames(poses, q.dtype), points_local(system, params, poses, u))
+    p_idx, q_idx, links, sph, revs, _ = _joint_layout(system)
+    d = x[p_idx] - x[q_idx]
+    link_rows = None
+    if links:
+        lengths = jnp.stack([params.joints[k].length for k in links])
+        dl = d[np.asarray(links)]
+        link_rows = (jnp.sum(dl * dl, axis=1) - lengths**2) / (2.0 * lengths)
+    rev_rows = []
+    for k in revs:
         i, j = system.joint_points[k]
-        d = point_position(system, params, poses, i, u) - point_position(system, params, poses, j, u)
         jp = params.joints[k]
-        if kind == "spherical":
-            rows.append(jnp.stack([d[c] for c in system.joint_components[k]]))
-        elif kind == "link":
-            rows.append(jnp.reshape((d @ d - jp.length**2) / (2.0 * jp.length), (1,)))
-        else:
-            ai = _point_rotation(system, poses, i)
-            aj = _point_rotation(system, poses, j)
-            n2, n3 = _orthonormal_pair(jp.axis_i)
-            n1j = aj @ jp.axis_j
-            rows.append(jnp.concatenate([d, jnp.stack([(ai @ n2) @ n1j, (ai @ n3) @ n1j])]))
-    if not rows:
-        return jnp.zeros((0,), q.dtype)
-    return jnp.concatenate(rows)
+        ai, aj = _point_rotation(system, poses, i), _point_rotation(system, poses, j)
+        n2, n3 = _orthonormal_pair(jp.axis_i)
+        n1j = aj @ jp.axis_j
+        rev_rows.append(jnp.concatenate([d[k], jnp.stack([(ai @ n2) @ n1j, (ai @ n3) @ n1j])]))
+    return _assemble_rows(system, link_rows, _sph_rows(sph, d), rev_rows, q.dtype)
 
 
 def _point_rotation(system: System, poses, k: int):
@@ -124,45 +216,36 @@ def _solve3(m, b):
     return (adj @ b) / jnp.dot(c0, jnp.cross(c1, c2))
 
 
-def _point_velocity_v(system: System, params: SystemParams, poses, vs, k: int, u):
-    """Global velocity of point ``k`` from the body velocities ``vs`` (linear in ``vs``;
-    input rates excluded, they enter through ``Phi_t``)."""
-    body = system.point_body[k]
-    if body < 0:
-        return jnp.zeros((3,), vs[0].dtype)
-    x = point_local(system, params, poses, k, u)
-    v = vs[body]
-    local = v[:3] + jnp.cross(v[3:6], x)
-    if system.n_modes[body] > 0:
-        local = local + params.bodies[body].coupling * (params.points[k].shapes @ v[6:])
-    return poses[body][1] @ local
-
-
 def constraint_rates(system: System, params: SystemParams, poses, vs, u) -> Float[Array, " m"]:
     """``Phi_q q_dot`` written explicitly in the body velocities (``Phi_q B`` applied to ``v``):
     linear in ``vs``, so its Jacobian needs no derivative of the rotation matrices."""
-    rows = []
-    for k, kind in enumerate(system.joint_kind):
+    dtype = vs[0].dtype
+    if system.n_constraints == 0:
+        return jnp.zeros((0,), dtype)
+    frames = _frames(poses, dtype)
+    local = points_local(system, params, poses, u)
+    x = points_global(system, frames, local)
+    xv = points_velocity(system, params, frames, vs, local)
+    p_idx, q_idx, links, sph, revs, _ = _joint_layout(system)
+    d, dv = x[p_idx] - x[q_idx], xv[p_idx] - xv[q_idx]
+    link_rows = None
+    if links:
+        lengths = jnp.stack([params.joints[k].length for k in links])
+        li = np.asarray(links)
+        link_rows = jnp.sum(d[li] * dv[li], axis=1) / lengths
+    rev_rows = []
+    for k in revs:
         i, j = system.joint_points[k]
-        dv = _point_velocity_v(system, params, poses, vs, i, u) - _point_velocity_v(system, params, poses, vs, j, u)
         jp = params.joints[k]
-        if kind == "spherical":
-            rows.append(jnp.stack([dv[c] for c in system.joint_components[k]]))
-        elif kind == "link":
-            d = point_position(system, params, poses, i, u) - point_position(system, params, poses, j, u)
-            rows.append(jnp.reshape(d @ dv / jp.length, (1,)))
-        else:
-            bi, bj = system.point_body[i], system.point_body[j]
-            ai, aj = _point_rotation(system, poses, i), _point_rotation(system, poses, j)
-            wi = jnp.zeros((3,), dv.dtype) if bi < 0 else vs[bi][3:6]
-            wj = jnp.zeros((3,), dv.dtype) if bj < 0 else vs[bj][3:6]
-            n2, n3 = _orthonormal_pair(jp.axis_i)
-            n1j, dn1j = aj @ jp.axis_j, aj @ jnp.cross(wj, jp.axis_j)
-            rate = [(ai @ jnp.cross(wi, n)) @ n1j + (ai @ n) @ dn1j for n in (n2, n3)]
-            rows.append(jnp.concatenate([dv, jnp.stack(rate)]))
-    if not rows:
-        return jnp.zeros((0,), vs[0].dtype)
-    return jnp.concatenate(rows)
+        bi, bj = system.point_body[i], system.point_body[j]
+        ai, aj = _point_rotation(system, poses, i), _point_rotation(system, poses, j)
+        wi = jnp.zeros((3,), dtype) if bi < 0 else vs[bi][3:6]
+        wj = jnp.zeros((3,), dtype) if bj < 0 else vs[bj][3:6]
+        n2, n3 = _orthonormal_pair(jp.axis_i)
+        n1j, dn1j = aj @ jp.axis_j, aj @ jnp.cross(wj, jp.axis_j)
+        rate = [(ai @ jnp.cross(wi, n)) @ n1j + (ai @ n) @ dn1j for n in (n2, n3)]
+        rev_rows.append(jnp.concatenate([dv[k], jnp.stack(rate)]))
+    return _assemble_rows(system, link_rows, _sph_rows(sph, dv), rev_rows, dtype)
 
 
 def body_velocities(system: System, params: SystemParams, q, y, poses=None) -> list:

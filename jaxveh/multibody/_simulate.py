@@ -13,8 +13,8 @@ from jaxtyping import Array, Float
 
 from ._dynamics import energy
 from ._errors import AssemblyError
-from ._projection import Inputs, dynamics, input_values, projection
-from ._kinematics import constraints
+from ._projection import Inputs, _dependent, _jacobians, dynamics, input_values, projection, solve_s
+from ._kinematics import body_poses, body_velocities, constraints, qdot_from_velocities
 from ._system import System, SystemParams
 
 #: Default gain (1/s) of the velocity-level drift stabilisation ``Phi_dot = -kappa Phi``.
@@ -102,17 +102,21 @@ def joint_velocities(system: System, params: SystemParams, q, z, t=0.0, inputs=N
 
 
 def project_coordinates(system: System, params: SystemParams, q, t, inputs=None, iterations: int = 2):
-    """Minimum-norm Newton projection of ``q`` onto ``Phi(q, t) = 0``:
-    ``q <- q - Phi_q^T (Phi_q Phi_q^T)^-1 Phi`` (a few iterations from a nearby point)."""
+    """Newton projection of ``q`` onto ``Phi(q, t) = 0`` in the dependent joint directions:
+    ``q <- q + B T dy`` with ``dy = -S Phi`` (independent velocities held), i.e. Newton's
+    method with the Jacobian ``Phi_q B T`` the projection already factorises. A few
+    iterations from a nearby point reach round-off."""
     if system.n_constraints == 0:
         return q
-    u = input_values(system, inputs, t, q.dtype)
+    t = jnp.asarray(t, q.dtype)
 
     def step(_, qq):
-        phi_q = jax.jacfwd(lambda x: constraints(system, params, x, u))(qq)
-        phi = constraints(system, params, qq, u)
-        lam = jnp.linalg.solve(phi_q @ phi_q.T, phi)
-        return qq - phi_q.T @ lam
+        phi, _, _, phi_y = _jacobians(system, params, qq, t, inputs)
+        lu = jax.scipy.linalg.lu_factor(phi_y[:, jnp.asarray(_dependent(system), dtype=int)])
+        dy = solve_s(system, lu, -phi)
+        poses = body_poses(system, params, qq)
+        vs = body_velocities(system, params, qq, dy, poses)
+        return qq + qdot_from_velocities(system, params, qq, dy, vs, poses)
 
     return jax.lax.fori_loop(0, iterations, step, q)
 
