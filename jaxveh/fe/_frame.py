@@ -17,6 +17,7 @@ import equinox as eqx
 import numpy as np
 from jaxtyping import Array, Float
 
+from .._config import check_x64
 from ..params import ParameterError, float_field
 from ._beam import CircularTube, Material, RectangularTube
 
@@ -193,6 +194,7 @@ def frame_from_dict(table: dict, where: str = "<dict>") -> Frame:
             zero-length members, non-positive section sizes or materials, a disconnected
             frame, bad torsion-test nodes. The message names the offending entry.
     """
+    check_x64()
     allowed = ("frame", "materials", "sections", "nodes", "members", "point_masses", "torsion_test")
     unknown = sorted(set(table) - set(allowed))
     if unknown:
