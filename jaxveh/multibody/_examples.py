@@ -214,8 +214,7 @@ def quarter_car(data=None, axle: str = "front") -> tuple[System, SystemParams]:
     data = load_vehicle_data() if data is None else data
     hp = (data.hard_points_front if axle == "front" else data.hard_points_rear).points
     unsprung = data.unsprung_front if axle == "front" else data.unsprung_rear
-    track = data.track_front if axle == "front" else data.track_rear
-    w = np.array([0.0, float(track) / 2.0, WHEEL_CENTRE_HEIGHT])
+    w = np.asarray(quarter_car_wheel_centre(data, axle))
     b = SystemBuilder(gravity=(0.0, 0.0, -9.81))
     b.add_input("rack")
     b.add_rigid_body("upright", float(unsprung.body.mass), np.asarray(unsprung.body.inertia), rotation="zxy")
@@ -235,9 +234,17 @@ def quarter_car(data=None, axle: str = "front") -> tuple[System, SystemParams]:
     return b.build()
 
 
+def quarter_car_wheel_centre(data=None, axle: str = "front"):
+    """Wheel centre (m, corner frame) of :func:`quarter_car`: ``(0, track / 2, 0.255)``."""
+    data = load_vehicle_data() if data is None else data
+    track = data.track_front if axle == "front" else data.track_rear
+    return jnp.stack([jnp.zeros_like(track), track / 2.0, jnp.full_like(track, WHEEL_CENTRE_HEIGHT)])
+
+
 def quarter_car_design_q(system: System, wheel_centre=None):
-    """Design-position coordinates: upright at the wheel centre, zero angles, zero spin."""
-    w = jnp.asarray([0.0, 0.63, WHEEL_CENTRE_HEIGHT]) if wheel_centre is None else jnp.asarray(wheel_centre)
+    """Design-position coordinates: upright at the wheel centre (default: front axle of the
+    shipped Appendix B data), zero angles, zero spin."""
+    w = quarter_car_wheel_centre() if wheel_centre is None else jnp.asarray(wheel_centre)
     return jnp.concatenate([w, jnp.zeros((system.n_q - 3,))])
 
 

@@ -22,7 +22,6 @@ p_dot...]``. Body velocities ``v = T y`` (eq. 5.49).
 import dataclasses
 
 import equinox as eqx
-import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
