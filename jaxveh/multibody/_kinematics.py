@@ -52,16 +52,6 @@ def point_local(system: System, params: SystemParams, poses, k: int, u) -> Float
     return x
 
 
-def point_position(system: System, params: SystemParams, poses, k: int, u) -> Float[Array, "3"]:
-    """Global position of point ``k`` (m), eqs. (5.6) and (5.12)."""
-    x = point_local(system, params, poses, k, u)
-    body = system.point_body[k]
-    if body < 0:
-        return x
-    r, a, _ = poses[body]
-    return r + a @ x
-
-
 def _frames(poses, dtype):
     """Stacked origins ``(nb + 1, 3)`` and rotations ``(nb + 1, 3, 3)``; row 0 is the ground."""
     rs = jnp.stack([jnp.zeros((3,), dtype)] + [p[0] for p in poses])
