@@ -4,6 +4,7 @@ their units in the key names."""
 
 import numpy as np
 
+import jax
 import jax.numpy as jnp
 
 from ..control import preview_controller, preview_distance
@@ -13,7 +14,7 @@ from ._linear import state_space
 from ._load_transfer import load_transfer_summary
 from ._maps import design_map, minimum_stiffness
 from ._model import PHIF, PHIR, R, VARIANTS
-from ._modes import frequency_response, vehicle_modes
+from ._modes import eigenvalues, frequency_response, vehicle_modes
 from ._quantities import GRAVITY, normalised_torsional_stiffness, roll_stiffness_proportion, with_distribution
 from ._roll_steer import understeer_summary
 from ._steady import skidpad_sweep
@@ -102,6 +103,18 @@ def eig_report(vehicle: AnalyticVehicle, speed_kmh=50.0, rigid=False) -> dict:
     _positive("speed_kmh", speed_kmh)
     modes = vehicle_modes(vehicle, speed_kmh * KMH, rigid)
     return {"speed_kmh": speed_kmh, "rigid": rigid, "modes": [{k: float(v) if k != "label" else v for k, v in m.items()} for m in modes]}
+
+
+def root_locus(vehicle: AnalyticVehicle, speed_kmh, mu_values=None) -> np.ndarray:
+    """Eigenvalues (1/s) versus µ at one speed, or versus speed (km/h array) at the vehicle's
+    µ when ``mu_values`` is None: one vmapped call. Entries with Im < 0 are NaN (the upper
+    half-plane is plotted, Fig. 3.9)."""
+    if mu_values is not None:
+        eig = jax.vmap(lambda m: eigenvalues(with_distribution(vehicle, mu=m), speed_kmh * KMH))(jnp.asarray(mu_values, dtype=jnp.float64))
+    else:
+        eig = jax.vmap(lambda u: eigenvalues(vehicle, u))(jnp.asarray(speed_kmh, dtype=jnp.float64) * KMH)
+    eig = np.asarray(eig)
+    return np.where(eig.imag >= 0, eig, np.nan)
 
 
 def bode_report(vehicle: AnalyticVehicle, speed_kmh=50.0, f_min=0.1, f_max=5.0, n=200, per_road_wheel=True) -> dict:

@@ -7,7 +7,6 @@ import numpy as np
 import typer
 
 from ..analytic import _reports as reports
-from ..analytic import eigenvalues, with_distribution
 from ..params import ParameterError, load_analytic_vehicle
 from ..plots import plot_bode, plot_map, plot_preview, plot_root_locus, plot_skidpad, plot_step_steer, save
 from ._common import emit_json, fail, write_json
@@ -122,10 +121,8 @@ def eig(
     veh = _vehicle(vehicle, lam, mu)
     result = _run(reports.eig_report, veh, speed_kmh, rigid)
     if plot is not None:
-        mus = np.geomspace(0.1, 10.0, 60)
-        loci = np.array([np.asarray(eigenvalues(with_distribution(veh, mu=m), speed_kmh / 3.6)) for m in mus])
-        loci = np.sort_complex(loci)
-        save(plot_root_locus({"eigenvalues": loci[:, loci[0].imag >= 0]}, title=f"µ = 0.1 (□) ... 10 (○), {speed_kmh:g} km/h"), plot)
+        loci = reports.root_locus(veh, speed_kmh, np.geomspace(0.1, 10.0, 80))
+        save(plot_root_locus({"eigenvalues": loci}, title=f"µ = 0.1 (□) ... 10 (○), {speed_kmh:g} km/h"), plot)
     if as_json:
         emit_json(result)
     else:
