@@ -18,12 +18,32 @@ def _split(system: System, x, offsets):
     return [x[offsets[i] : offsets[i + 1]] for i in range(system.n_bodies)]
 
 
+def _free_groups(system: System) -> dict[str, list[int]]:
+    """Free bodies grouped by rotation sequence (static), for one vmapped call per group."""
+    groups: dict[str, list[int]] = {}
+    for i in range(system.n_bodies):
+        if system.tree_kind[i] == FREE:
+            groups.setdefault(system.sequence[i], []).append(i)
+    return groups
+
+
+def _angle_rows(system: System, bodies: list[int]) -> np.ndarray:
+    """Static ``(n, 3)`` indices of the rotation angles of ``bodies`` in ``q``."""
+    return np.asarray([[system.q_offsets[i] + 3 + k for k in range(3)] for i in bodies], dtype=int)
+
+
 def body_poses(system: System, params: SystemParams, q: Float[Array, " nq"]) -> list[tuple]:
-    """``[(r_i, A_i, p_i)]`` for every body: origin (m, global), rotation, modal coordinates."""
+    """``[(r_i, A_i, p_i)]`` for every body: origin (m, global), rotation, modal coordinates.
+
+    Rotation matrices of free bodies are computed in one vmapped call per sequence."""
+    rotations = {}
+    for seq, bodies in _free_groups(system).items():
+        mats = jax.vmap(lambda a, seq=seq: rotation_matrix(seq, a))(q[_angle_rows(system, bodies)])
+        rotations.update({i: mats[k] for k, i in enumerate(bodies)})
     poses = []
     for i, qi in enumerate(_split(system, q, system.q_offsets)):
         if system.tree_kind[i] == FREE:
-            poses.append((qi[:3], rotation_matrix(system.sequence[i], qi[3:6]), qi[6:]))
+            poses.append((qi[:3], rotations[i], qi[6:]))
         else:
             rp, ap = _parent_pose(poses, system.parent[i], q.dtype)
             joint = params.tree[i]
@@ -268,13 +288,17 @@ def body_velocities(system: System, params: SystemParams, q, y, poses=None) -> l
 def qdot_from_velocities(system: System, params: SystemParams, q, y, vs, poses) -> Float[Array, " nq"]:
     """``q_dot = B v`` for free bodies (eq. 5.31) and the joint rates for tree joints."""
     ys = _split(system, y, system.q_offsets)
+    rates = {}
+    for seq, bodies in _free_groups(system).items():
+        w = jnp.stack([vs[i][3:6] for i in bodies])
+        r = jax.vmap(lambda a, wi, seq=seq: _solve3(angular_velocity_matrix(seq, a), wi))(
+            q[_angle_rows(system, bodies)], w
+        )
+        rates.update({i: r[k] for k, i in enumerate(bodies)})
     out = []
     for i in range(system.n_bodies):
         if system.tree_kind[i] == FREE:
-            _, a, _ = poses[i]
-            qi = q[system.q_offsets[i] : system.q_offsets[i] + 6]
-            gr = angular_velocity_matrix(system.sequence[i], qi[3:6])
-            out.append(jnp.concatenate([a @ vs[i][:3], _solve3(gr, vs[i][3:6]), vs[i][6:]]))
+            out.append(jnp.concatenate([poses[i][1] @ vs[i][:3], rates[i], vs[i][6:]]))
         else:
             out.append(ys[i])
     return jnp.concatenate(out)
