@@ -25,9 +25,10 @@ import optax
 
 import jaxveh.fe as fe
 
-#: Practical tube limits: 15-35 mm diameter, 0.9-3 mm wall (weldable chromoly).
+#: Practical tube limits (as in experiments/fe_tune_frame.py): 15-35 mm diameter,
+#: 0.8-3 mm wall (0.8 mm = 0.032 in, the thinnest common chromoly frame tube).
 D_BOUNDS = (15e-3, 35e-3)
-T_BOUNDS = (0.9e-3, 3.0e-3)
+T_BOUNDS = (0.8e-3, 3.0e-3)
 
 
 def _sizes(x):
