@@ -15,7 +15,6 @@ from importlib import resources
 from pathlib import Path
 
 import jax
-import jax.numpy as jnp
 
 import jaxveh.fe as fe
 

@@ -1,6 +1,5 @@
 """Modal truncation and Craig-Bampton: reference eigen-solutions, bounds, Fig. 6.9 trends."""
 
-import jax
 import numpy as np
 import pytest
 import scipy.linalg
