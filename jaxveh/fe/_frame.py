@@ -8,9 +8,7 @@ it; :func:`frame_from_dict` does the same for an already-parsed table.
 """
 
 import math
-import tomllib
 from collections import deque
-from importlib import resources
 from pathlib import Path
 
 import equinox as eqx
@@ -18,7 +16,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .._config import check_x64
-from ..params import ParameterError, float_field
+from ..params import ParameterError, float_field, read_toml
 from ._beam import CircularTube, Material, RectangularTube
 
 Section = CircularTube | RectangularTube
@@ -340,16 +338,5 @@ def frame_from_dict(table: dict, where: str = "<dict>") -> Frame:
 
 def load_frame(path: str | Path | None = None) -> Frame:
     """Load a frame TOML file (default: the shipped FSAE 2009 frame)."""
-    if path is None:
-        text = resources.files("jaxveh.fe").joinpath("data/fsae_2009_frame.toml").read_text()
-        where = "fsae_2009_frame.toml"
-    else:
-        path = Path(path)
-        if not path.is_file():
-            raise ParameterError(f"frame file {str(path)!r} does not exist")
-        text, where = path.read_text(), str(path)
-    try:
-        table = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ParameterError(f"{where}: not valid TOML ({e})") from None
+    table, where = read_toml(path, "jaxveh.fe", "data/fsae_2009_frame.toml", "frame")
     return frame_from_dict(table, where)
