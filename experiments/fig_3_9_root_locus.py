@@ -10,6 +10,11 @@ from jaxveh.params import load_analytic_vehicle
 from jaxveh.plots import plot_root_locus, save
 
 
+def _labels(vehicle, speed_kmh):
+    """(label, eigenvalue) of each mode, for annotating the loci."""
+    return [(m["label"], complex(m["real"], m["imag"])) for m in eig_report(vehicle, speed_kmh)["modes"]]
+
+
 def main():
     out = output_dir("fig_3_9", __doc__)
     vehicle = load_analytic_vehicle()
@@ -18,8 +23,10 @@ def main():
     by_mu = root_locus(vehicle, 50.0, mus)
     by_speed = root_locus(vehicle, speeds_kmh)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5))
-    plot_root_locus({"eigenvalues": by_mu}, ax=axes[0], title="(a) µ = 0.1 (□) ... 10 (○), 50 km/h")
-    plot_root_locus({"eigenvalues": by_speed}, ax=axes[1], title="(b) 5 (□) ... 120 km/h (○), µ = 1")
+    plot_root_locus({"eigenvalues": by_mu}, ax=axes[0], title="(a) µ = 0.1 (□) ... 10 (○), 50 km/h",
+                    mode_labels=_labels(with_distribution(vehicle, mu=float(mus[-1])), 50.0))
+    plot_root_locus({"eigenvalues": by_speed}, ax=axes[1], title="(b) 5 (□) ... 120 km/h (○), µ = 1",
+                    mode_labels=_labels(vehicle, float(speeds_kmh[-1])))
     save(fig, out / "fig_3_9.png")
     modes = {m: eig_report(with_distribution(vehicle, mu=m), 50.0)["modes"] for m in (0.1, 1.0, 10.0)}
     write_json({"mu": mus, "eig_by_mu_real": by_mu.real, "eig_by_mu_imag": by_mu.imag, "speed_kmh": speeds_kmh,

@@ -97,8 +97,11 @@ def plot_step_steer(report: dict):
     return fig
 
 
-def plot_root_locus(loci: dict, ax=None, title: str = ""):
-    """Eigenvalue loci ``{label: complex array (n_param, n_modes)}`` with ζ and ωn grid (Fig. 3.9)."""
+def plot_root_locus(loci: dict, ax=None, title: str = "", mode_labels=()):
+    """Eigenvalue loci ``{label: complex array (n_param, n_modes)}`` with ζ and ωn grid (Fig. 3.9).
+
+    ``mode_labels``: (text, complex eigenvalue) pairs written beside the loci.
+    """
     fig = None
     if ax is None:
         fig, ax = plt.subplots(figsize=(5.5, 4.5))
@@ -117,6 +120,8 @@ def plot_root_locus(loci: dict, ax=None, title: str = ""):
     for wn in np.arange(20, radius + 1, 20):
         th = np.linspace(np.pi / 2, np.pi, 100)
         ax.plot(wn * np.cos(th), wn * np.sin(th), ":", color="grey", lw=0.6)
+    for text, point in mode_labels:
+        ax.annotate(text, (point.real, point.imag), textcoords="offset points", xytext=(6, 4), fontsize=8)
     ax.set_xlim(xmin, max(xmax, 0.0))
     ax.set_ylim(0, ymax)
     ax.set_xlabel("Re [1/s]")
