@@ -8,6 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+import jaxveh
 from jaxveh import multibody as mb
 from jaxveh.multibody import _examples as ex
 from jaxveh.params import HARD_POINT_NAMES, load_vehicle_data
@@ -121,7 +122,7 @@ def test_redundant_sixth_link_is_named():
 def drop_run(car):
     system, params = car
     q0 = ex.quarter_car_design_q(system)
-    rate = ex.WheelRate(k=20000.0, c=0.0, z0=ex.WHEEL_CENTRE_HEIGHT, fz=14.0 * 9.81)
+    rate = ex.WheelRate(k=20000.0, c=0.0, z0=ex.WHEEL_CENTRE_HEIGHT, fz=14.0 * jaxveh.GRAVITY)
     inputs = lambda t: jnp.zeros((1,))  # noqa: E731
 
     def run(params, rate, bump0):

@@ -10,6 +10,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
+from .._core import GRAVITY
 from ..params import HARD_POINT_NAMES, ParameterError, float_field, load_vehicle_data
 
 from ._rotations import rotation_matrix
@@ -30,7 +31,7 @@ DOUBLE_PENDULUM_DEFAULTS = {
     "l1": 1.0,
     "a1": 0.5,
     "a2": 0.4,
-    "g": 9.81,
+    "g": GRAVITY,
 }
 
 
@@ -120,7 +121,7 @@ FOUR_BAR_DEFAULTS = {
     "m_crank": 0.5,
     "m_coupler": 1.0,
     "m_rocker": 0.8,
-    "g": 9.81,
+    "g": GRAVITY,
 }
 
 
@@ -215,7 +216,7 @@ def quarter_car(data=None, axle: str = "front") -> tuple[System, SystemParams]:
     hp = (data.hard_points_front if axle == "front" else data.hard_points_rear).points
     unsprung = data.unsprung_front if axle == "front" else data.unsprung_rear
     w = np.asarray(quarter_car_wheel_centre(data, axle))
-    b = SystemBuilder(gravity=(0.0, 0.0, -9.81))
+    b = SystemBuilder(gravity=(0.0, 0.0, -GRAVITY))
     b.add_input("rack")
     b.add_rigid_body("upright", float(unsprung.body.mass), np.asarray(unsprung.body.inertia), rotation="zxy")
     spin = float(unsprung.wheel_spin_inertia)
@@ -335,7 +336,7 @@ def flexible_beam(length=1.0, n_modes=2, diameter=0.012, thickness=0.001, beta=0
     return straight_beam_body(length, n_modes, n_elements, diameter, thickness, beta)
 
 
-def flexible_pendulum(modal=None, coupling=1.0, pinned: bool = True, gravity=9.81) -> tuple[System, SystemParams]:
+def flexible_pendulum(modal=None, coupling=1.0, pinned: bool = True, gravity=GRAVITY) -> tuple[System, SystemParams]:
     """A flexible beam (modal body, floating frame) swinging in the x-z plane.
 
     ``pinned``: the beam's ``start`` point is held on the ground origin by a revolute joint

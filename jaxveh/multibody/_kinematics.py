@@ -10,7 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ._rotations import angular_velocity_matrix, axis_angle, rotation_matrix
+from ._rotations import angular_velocity_matrix, axis_angle, rotation_matrix, skew
 from ._system import FREE, System, SystemParams
 
 
@@ -207,16 +207,47 @@ def constraints(system: System, params: SystemParams, q, u=None) -> Float[Array,
     for k in revs:
         i, j = system.joint_points[k]
         jp = params.joints[k]
-        ai, aj = _point_rotation(system, poses, i), _point_rotation(system, poses, j)
+        ai, aj = _point_rotation(system, params, poses, i), _point_rotation(system, params, poses, j)
         n2, n3 = _orthonormal_pair(jp.axis_i)
         n1j = aj @ jp.axis_j
         rev_rows.append(jnp.concatenate([d[k], jnp.stack([(ai @ n2) @ n1j, (ai @ n3) @ n1j])]))
     return _assemble_rows(system, link_rows, _sph_rows(sph, d), rev_rows, q.dtype)
 
 
-def _point_rotation(system: System, poses, k: int):
+def point_small_rotation(system: System, params: SystemParams, k: int, modal_values):
+    """Small rotation (rad, body axes) of the material at point ``k`` from the body's
+    deformation: ``coupling * Psi_r p`` (zero on rigid bodies and ground)."""
     body = system.point_body[k]
-    return jnp.eye(3, dtype=poses[0][0].dtype) if body < 0 else poses[body][1]
+    if body < 0 or system.n_modes[body] == 0:
+        return None
+    return params.bodies[body].coupling * (params.points[k].rotation_shapes @ modal_values)
+
+
+def _point_rotation(system: System, params: SystemParams, poses, k: int):
+    """Orientation of the material frame at point ``k``: the body rotation, times
+    ``I + skew(Psi_r p)`` on flexible bodies (first order in the modal coordinates, as the
+    modal displacement field itself)."""
+    body = system.point_body[k]
+    if body < 0:
+        return jnp.eye(3, dtype=poses[0][0].dtype)
+    a = poses[body][1]
+    theta = point_small_rotation(system, params, k, poses[body][2])
+    return a if theta is None else a + a @ skew(theta)
+
+
+def _point_rotation_rate(system: System, params: SystemParams, poses, vs, k: int, dtype):
+    """Time derivative of :func:`_point_rotation`:
+    ``d/dt [A (I + skew(theta))] = A (skew(w) (I + skew(theta)) + skew(theta_dot))``."""
+    body = system.point_body[k]
+    if body < 0:
+        return jnp.zeros((3, 3), dtype)
+    a, w = poses[body][1], vs[body][3:6]
+    theta = point_small_rotation(system, params, k, poses[body][2])
+    if theta is None:
+        return a @ skew(w)
+    theta_dot = point_small_rotation(system, params, k, vs[body][6:])
+    eye = jnp.eye(3, dtype=dtype)
+    return a @ (skew(w) @ (eye + skew(theta)) + skew(theta_dot))
 
 
 def _solve3(m, b):
@@ -247,13 +278,12 @@ def constraint_rates(system: System, params: SystemParams, poses, vs, u) -> Floa
     for k in revs:
         i, j = system.joint_points[k]
         jp = params.joints[k]
-        bi, bj = system.point_body[i], system.point_body[j]
-        ai, aj = _point_rotation(system, poses, i), _point_rotation(system, poses, j)
-        wi = jnp.zeros((3,), dtype) if bi < 0 else vs[bi][3:6]
-        wj = jnp.zeros((3,), dtype) if bj < 0 else vs[bj][3:6]
+        ai, aj = _point_rotation(system, params, poses, i), _point_rotation(system, params, poses, j)
+        ai_dot = _point_rotation_rate(system, params, poses, vs, i, dtype)
+        aj_dot = _point_rotation_rate(system, params, poses, vs, j, dtype)
         n2, n3 = _orthonormal_pair(jp.axis_i)
-        n1j, dn1j = aj @ jp.axis_j, aj @ jnp.cross(wj, jp.axis_j)
-        rate = [(ai @ jnp.cross(wi, n)) @ n1j + (ai @ n) @ dn1j for n in (n2, n3)]
+        n1j, dn1j = aj @ jp.axis_j, aj_dot @ jp.axis_j
+        rate = [(ai_dot @ n) @ n1j + (ai @ n) @ dn1j for n in (n2, n3)]
         rev_rows.append(jnp.concatenate([dv[k], jnp.stack(rate)]))
     return _assemble_rows(system, link_rows, _sph_rows(sph, dv), rev_rows, dtype)
 

@@ -25,7 +25,7 @@ import equinox as eqx
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import ParameterError, float_field
+from .._core import GRAVITY, ParameterError, float_field
 from ._bodies import FlexibleBody, FlexOptions, RigidBody
 from ._rotations import SEQUENCES
 
@@ -49,12 +49,15 @@ class TreeRevolute(eqx.Module):
 
 class Point(eqx.Module):
     """A point on a body: undeformed position (m, body axes), translational mode shapes at the
-    point (3 x nm, m per unit modal coordinate; empty for rigid bodies) and the body-axes
-    direction along which a rheonomic input moves it (m per unit input; zero if none)."""
+    point (3 x nm, m per unit modal coordinate; empty for rigid bodies), rotational mode
+    shapes (3 x nm, rad per unit modal coordinate: the small rotation of the material at the
+    point, body axes) and the body-axes direction along which a rheonomic input moves it (m
+    per unit input; zero if none)."""
 
     position: Float[Array, "3"] = float_field()
     shapes: Float[Array, "3 nm"] = float_field()
     input_direction: Float[Array, "3"] = float_field()
+    rotation_shapes: Float[Array, "3 nm"] = float_field()
 
 
 class Spherical(eqx.Module):
@@ -221,7 +224,7 @@ class SystemBuilder:
 
     Example (thesis section 5.7)::
 
-        b = SystemBuilder(gravity=(0.0, 0.0, -9.81))
+        b = SystemBuilder(gravity=(0.0, 0.0, -GRAVITY))
         b.add_rigid_body("B1", mass=m1, inertia=np.diag([J1, J1, J1]))
         b.add_point("P0", "ground", (0, 0, 0)); b.add_point("P1", "B1", (0, 0, a1))
         b.add_revolute("C1", "P0", "P1", axis_i=(1, 0, 0), axis_j=(1, 0, 0))
@@ -229,7 +232,7 @@ class SystemBuilder:
         system, params = b.build()
     """
 
-    def __init__(self, gravity=(0.0, 0.0, -9.81), options: FlexOptions = FlexOptions()):
+    def __init__(self, gravity=(0.0, 0.0, -GRAVITY), options: FlexOptions = FlexOptions()):
         self._gravity = gravity
         self._options = options
         self._bodies: list[tuple] = []  # (name, params, parent, kind, sequence, tree params)
@@ -297,17 +300,30 @@ class SystemBuilder:
         if modal is None or not hasattr(modal, "point_index"):
             raise ValueError(f"point {name!r}: body {body!r} is not a flexible body")
         k = modal.point_index(modal_point)
-        self.add_point(name, body, modal.point_xyz[k], modal.point_phi_translation[k], input, input_direction)
+        self.add_point(
+            name,
+            body,
+            modal.point_xyz[k],
+            modal.point_phi_translation[k],
+            input,
+            input_direction,
+            rotation_shapes=modal.point_phi_rotation[k],
+        )
 
     # ---- points, inputs -----------------------------------------------------------
     def add_input(self, name: str) -> None:
         """Declare a rheonomic input (e.g. the steering-rack travel, m)."""
         self._inputs.append(name)
 
-    def add_point(self, name, body, position, shapes=None, input=None, input_direction=(0.0, 0.0, 0.0)):
+    def add_point(
+        self, name, body, position, shapes=None, input=None, input_direction=(0.0, 0.0, 0.0), rotation_shapes=None
+    ):
         """``definepoint``: a point at ``position`` (m, body axes) on ``body`` (or ``"ground"``).
 
         ``shapes`` (3 x nm): the body's translational mode shapes at the point (flexible body).
+        ``rotation_shapes`` (3 x nm, rad): its rotational mode shapes there; they turn the
+        axes of revolute joints and the torques of force elements at the point (zero when
+        omitted: a point that carries no moment).
         ``input``: name of a rheonomic input that moves the point by
         ``input_value * input_direction`` in body axes (the steering rack moving point M).
         """
@@ -318,10 +334,17 @@ class SystemBuilder:
         shapes = np.zeros((3, nm)) if shapes is None else np.asarray(shapes, dtype=np.float64)
         if shapes.shape != (3, nm):
             raise ValueError(f"point {name!r}: shapes must be 3 x {nm} for body {body!r}, got {shapes.shape}")
+        rot = np.zeros((3, nm)) if rotation_shapes is None else np.asarray(rotation_shapes, dtype=np.float64)
+        if rot.shape != (3, nm):
+            raise ValueError(f"point {name!r}: rotation_shapes must be 3 x {nm} for body {body!r}, got {rot.shape}")
+        position = np.asarray(position, dtype=np.float64)
+        if position.shape != (3,) or not np.all(np.isfinite(position)):
+            raise ParameterError(f"point {name!r}: position must be a finite 3-vector (m), got {position.tolist()}")
         if input is not None and input not in self._inputs:
             raise ValueError(f"point {name!r}: unknown input {input!r}; declare it with add_input first")
         ii = -1 if input is None else self._inputs.index(input)
-        self._points.append((name, bi, Point(position=position, shapes=shapes, input_direction=input_direction), ii))
+        point = Point(position=position, shapes=shapes, input_direction=input_direction, rotation_shapes=rot)
+        self._points.append((name, bi, point, ii))
 
     # ---- joints -------------------------------------------------------------------
     def _point_pair(self, jname, p, q):
