@@ -35,7 +35,17 @@ def sweeps(system, params):
     rack = np.linspace(-0.02, 0.02, 41)
     b_out = kin(jnp.asarray(bump), jnp.zeros_like(jnp.asarray(bump)))
     r_out = kin(jnp.zeros_like(jnp.asarray(rack)), jnp.asarray(rack))
-    return bump, {k: np.asarray(v) for k, v in b_out.items()}, rack, {k: np.asarray(v) for k, v in r_out.items()}
+    return bump, _masked(b_out), rack, _masked(r_out)
+
+
+def _masked(out):
+    """Outputs as NumPy with points that failed to assemble (``ok`` False) set to NaN, so
+    they are neither plotted nor reported as results."""
+    ok = np.asarray(out["ok"])
+    if not ok.all():
+        print(f"warning: {int((~ok).sum())} sweep point(s) could not be assembled; left out")
+    return {k: np.where(ok.reshape(ok.shape + (1,) * (np.ndim(v) - 1)), np.asarray(v), np.nan)
+            for k, v in out.items() if k != "ok"}
 
 
 def gradients(system, params):

@@ -54,19 +54,20 @@ def check_range(name: str, value, *, low=None, high=None, low_open=False, high_o
 
     Concrete values raise :class:`ParameterError` naming ``name``, the offending value and
     the allowed range; traced values are checked at run time with ``eqx.error_if`` (the
-    returned array must then be used). NaN is always refused. Returns ``value`` as float64.
+    returned array must then be used). NaN and infinities are always refused. Returns
+    ``value`` as float64.
     """
     value = as_float(value)
     lo_txt = "-inf" if low is None else f"{low:g}"
     hi_txt = "inf" if high is None else f"{high:g}"
     allowed = f"{'(' if low_open or low is None else '['}{lo_txt}, {hi_txt}{')' if high_open or high is None else ']'}"
-    bad = jnp.isnan(value)
+    bad = ~jnp.isfinite(value)
     if low is not None:
         bad = bad | ((value <= low) if low_open else (value < low))
     if high is not None:
         bad = bad | ((value >= high) if high_open else (value > high))
     message = f"{name} must lie in {allowed}{' (' + what + ')' if what else ''}"
-    if is_concrete(value):
+    if is_concrete(bad):  # inside jit even constants give traced results
         bad_np = np.asarray(bad)
         if bad_np.any():
             shown = np.asarray(value)[bad_np].ravel()[:3]

@@ -171,3 +171,46 @@ def test_gradient_of_simulation_wrt_mass_and_hard_point(car, drop_run):
         (float(f(x0.at[i].add(h))) - float(f(x0.at[i].add(-h)))) / (2 * h) for i, h in ((0, 1e-4), (1, 1e-6))
     ]
     np.testing.assert_allclose(g, fd, rtol=1e-4)
+
+
+def test_unreachable_travel_raises_naming_constraint_and_gap(car):
+    system, params = car
+    with pytest.raises(mb.AssemblyError, match=r"bump 400 mm.*constraint \w+\[length\] misses by \d"):
+        ex.quarter_car_kinematics(system, params, 0.4, 0.0)
+
+
+def test_unreachable_travel_in_jitted_sweep_is_flagged_and_finite(car):
+    system, params = car
+    sweep = jax.jit(jax.vmap(lambda b: ex.quarter_car_kinematics(system, params, b, 0.0)[1]))
+    out = sweep(jnp.asarray([0.0, 0.02, 0.4]))
+    np.testing.assert_array_equal(np.asarray(out["ok"]), [True, True, False])
+    for key in ("camber", "toe", "track", "wheel_centre", "residual"):
+        assert np.all(np.isfinite(np.asarray(out[key])))
+    assert float(out["residual"][2]) > 1e-3  # the failed point says it failed
+
+
+@pytest.mark.parametrize("link", ["lower_front", "upper_front"])
+def test_halved_link_branch_jump_is_refused(car, link):
+    """Halving a wishbone link lets Newton converge to a distant branch (70-125 deg of
+    upright rotation): refused with a message, not returned as a camber curve."""
+    system, params = car
+    k = system.joint_names.index(link)
+    halved = eqx.tree_at(lambda p: p.joints[k].length, params, params.joints[k].length * 0.5)
+    result = mb.solve_assembly(
+        system, halved, ex.quarter_car_design_q(system), (system.q_index("upright", "z"), 6),
+        inputs=lambda t: jnp.zeros((1,)),
+    )
+    assert float(result.residual) < mb.ASSEMBLY_TOL  # Newton did converge ...
+    assert not bool(result.ok)  # ... but on another branch
+    with pytest.raises(mb.AssemblyError, match="jumped to another branch: a body rotated by"):
+        ex.quarter_car_kinematics(system, halved, 0.0, 0.0)
+
+
+def test_cli_inspect_unreachable_travel_fails_cleanly():
+    from typer.testing import CliRunner
+
+    from jaxveh.cli import app
+
+    result = CliRunner().invoke(app, ["multibody", "inspect", "quarter-car", "--q", "0.4", "0", "--json"])
+    assert result.exit_code == 2
+    assert "cannot assemble: constraint" in result.output

@@ -51,7 +51,7 @@ def inspect(
         ..., help="double-pendulum | four-bar | quarter-car | flexible-pendulum"
     ),
     param: list[str] = typer.Option([], "--param", help="NAME=VALUE, e.g. --param m2=1.2 (repeatable)"),
-    json_out: bool = typer.Option(False, "--json", help="print JSON only"),
+    as_json: bool = typer.Option(False, "--json", help="print JSON only"),
 ) -> None:
     """Print the reduced mass matrix, internal and external forces and R of EXAMPLE.
 
@@ -60,15 +60,16 @@ def inspect(
     double pendulum (thesis section 5.7) these are theta1 (absolute) and theta2 (relative),
     in rad and rad/s; parameters m1, m2 (kg), J1, J2 (kg m^2), l1, a1, a2 (m), g (m/s^2).
     """
+    from ..multibody import AssemblyError
     from ..multibody._examples import inspect_example
     from ..params import ParameterError
 
     values = _parse_values(list(ctx.args))
     try:
         result = inspect_example(example, values.get("--q"), values.get("--qdot"), _parse_params(param))
-    except ParameterError as e:
+    except (ParameterError, AssemblyError) as e:
         fail(str(e))
-    if json_out:
+    if as_json:
         emit_json(result)
         return
     typer.echo(f"{result['example']}: independent velocities {result['independent_velocities']}")

@@ -42,6 +42,11 @@ from ._kinematics import (
     velocity_matrix_b as velocity_matrix_b,
     velocity_matrix_dot as velocity_matrix_dot,
 )
+from ._linear import (
+    Linearisation as Linearisation,
+    chart as chart,
+    linearise as linearise,
+)
 from ._projection import (
     Dynamics as Dynamics,
     Projection as Projection,
@@ -61,6 +66,10 @@ from ._rotations import (
 from ._simulate import (
     ASSEMBLY_TOL as ASSEMBLY_TOL,
     DEFAULT_KAPPA as DEFAULT_KAPPA,
+    MAX_BRANCH_ROTATION as MAX_BRANCH_ROTATION,
+    AssemblyResult as AssemblyResult,
+    assembly_message as assembly_message,
+    solve_assembly as solve_assembly,
     ProjectedSolver as ProjectedSolver,
     Simulation as Simulation,
     project_coordinates as project_coordinates,
@@ -75,4 +84,5 @@ from ._system import (
     System as System,
     SystemBuilder as SystemBuilder,
     SystemParams as SystemParams,
+    checked_params as checked_params,
 )

@@ -10,7 +10,8 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from .._core import GRAVITY
+from .._core import GRAVITY, is_concrete
+from ._errors import AssemblyError
 from ..params import HARD_POINT_NAMES, ParameterError, float_field, load_vehicle_data
 
 from ._rotations import rotation_matrix
@@ -303,12 +304,20 @@ def wheel_angles(system: System, params: SystemParams, q):
     return jnp.arctan2(-a[2], a[1]), jnp.arctan2(a[0], a[1])
 
 
-def quarter_car_kinematics(system: System, params: SystemParams, bump, rack, wheel_centre=None, iterations=25):
+def quarter_car_kinematics(
+    system: System, params: SystemParams, bump, rack, wheel_centre=None, iterations=25, throw: bool = True
+):
     """Assemble the quarter car at wheel-centre vertical travel ``bump`` (m) and rack travel
     ``rack`` (m); returns ``(q, outputs)`` with camber and toe-in (rad), wheel-centre
-    position (m) and track (m, twice the wheel-centre y) and the max constraint residual."""
-    from ._kinematics import constraints
-    from ._simulate import assemble
+    position (m), track (m, twice the wheel-centre y), the max constraint residual and
+    ``ok`` (the travel was reached on the design branch).
+
+    A travel that cannot be reached (or a solve that leaves the design branch) raises
+    :class:`AssemblyError` for concrete values with ``throw``; under ``jit`` / ``vmap``
+    (sweeps) nothing raises: the outputs stay finite and ``ok`` is False at that point, so
+    callers must honour the flag.
+    """
+    from ._simulate import assembly_message, solve_assembly
 
     q0 = quarter_car_design_q(system, wheel_centre)
     iz = system.q_index("upright", "z")
@@ -316,11 +325,23 @@ def quarter_car_kinematics(system: System, params: SystemParams, bump, rack, whe
     fixed = (iz, system.q_index("wheel", "theta"))
     rack = jnp.asarray(rack, jnp.float64)
     inputs = lambda t: jnp.reshape(rack, (1,))  # noqa: E731
-    q = assemble(system, params, q_guess, fixed, 0.0, inputs, iterations, throw=False)
+    result = solve_assembly(system, params, q_guess, fixed, 0.0, inputs, iterations)
+    if throw and is_concrete(result.ok) and not bool(result.ok):
+        raise AssemblyError(
+            f"quarter car at bump {float(bump) * 1e3:g} mm, rack {float(rack) * 1e3:g} mm: "
+            + assembly_message(system, result)
+        )
+    q = result.q
     camber, toe = wheel_angles(system, params, q)
     wc = q[:3]
-    residual = jnp.max(jnp.abs(constraints(system, params, q, jnp.reshape(rack, (1,)))))
-    return q, {"camber": camber, "toe": toe, "wheel_centre": wc, "track": 2.0 * wc[1], "residual": residual}
+    return q, {
+        "camber": camber,
+        "toe": toe,
+        "wheel_centre": wc,
+        "track": 2.0 * wc[1],
+        "residual": result.residual,
+        "ok": result.ok,
+    }
 
 
 # ---------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from jaxtyping import Array, Float
 from ._projection import Inputs, dynamics, projection
 from ._simulate import project_coordinates
 from ._kinematics import velocity_matrix
-from ._system import System, SystemParams
+from ._system import System, SystemParams, checked_params
 
 #: Newton iterations of the chart ``q(s)``: two give exact first and second derivatives at
 #: ``s = 0`` (Newton converges quadratically), two more make the chart accurate near it.
@@ -64,6 +64,7 @@ def linearise(
     is None. Rheonomic inputs are held at their time history.
     """
     q, z = jnp.asarray(q, jnp.float64), jnp.asarray(z, jnp.float64)
+    params = checked_params(system, params)
     t = jnp.asarray(t, q.dtype)
     q_of = chart(system, params, q, t, inputs)
     w0 = jnp.zeros((0,), q.dtype) if args is None else jnp.asarray(args, q.dtype)

@@ -14,8 +14,9 @@ from jaxtyping import Array, Float
 from ._dynamics import energy
 from ._errors import AssemblyError
 from ._projection import Inputs, _dependent, _jacobians, dynamics, input_values, projection, solve_s
-from ._kinematics import body_poses, body_velocities, constraints, qdot_from_velocities
-from ._system import System, SystemParams
+from .._core import is_concrete
+from ._kinematics import body_poses, body_velocities, constraints, marker_positions, qdot_from_velocities
+from ._system import System, SystemParams, checked_params
 
 #: Default gain (1/s) of the velocity-level drift stabilisation ``Phi_dot = -kappa Phi``.
 DEFAULT_KAPPA = 20.0
@@ -23,7 +24,54 @@ DEFAULT_KAPPA = 20.0
 ASSEMBLY_TOL = 1e-10
 
 
-def assemble(
+#: Largest rotation (rad) of any body between the initial guess and the assembled
+#: configuration that :func:`assemble` accepts by default. A Newton solve that turns a body
+#: further has almost always left the intended assembly branch (e.g. a wheel flipped
+#: through 90 deg of camber); steering an upright by a rack stays well within it.
+MAX_BRANCH_ROTATION = 0.75
+
+
+class AssemblyResult(eqx.Module):
+    """Outcome of :func:`solve_assembly`: ``q`` (the guess wherever the solve produced
+    non-finite values, so the result is NaN-free), ``residual`` (max |Phi|, m or rad),
+    ``worst`` (row of the largest residual), ``rotation`` (largest body rotation from the
+    guess, rad), ``flipped`` (a link reversed its direction relative to the guess), and
+    ``ok`` (converged below ``ASSEMBLY_TOL`` on the guess's branch)."""
+
+    q: Float[Array, " nq"]
+    residual: Float[Array, ""]
+    worst: Array
+    rotation: Float[Array, ""]
+    flipped: Array
+    ok: Array
+
+
+def _body_rotations(system, params, q):
+    return jnp.stack([pose[1] for pose in body_poses(system, params, q)])
+
+
+def _rotation_change(system, params, q_from, q_to):
+    """Largest rotation angle (rad) of any body between two configurations."""
+    a, b = _body_rotations(system, params, q_from), _body_rotations(system, params, q_to)
+    cos = (jnp.einsum("kij,kij->k", a, b) - 1.0) / 2.0
+    return jnp.max(jnp.arccos(jnp.clip(cos, -1.0, 1.0)))
+
+
+def _links_flipped(system, params, q_from, q_to, u):
+    """True when a link joint's vector turned by more than 90 deg (a reversed link)."""
+    links = [k for k, kind in enumerate(system.joint_kind) if kind == "link"]
+    if not links:
+        return jnp.asarray(False)
+    idx = np.asarray([system.joint_points[k] for k in links], dtype=int)
+
+    def vectors(q):
+        x = marker_positions(system, params, q, u)
+        return x[idx[:, 0]] - x[idx[:, 1]]
+
+    return jnp.any(jnp.sum(vectors(q_from) * vectors(q_to), axis=1) <= 0.0)
+
+
+def solve_assembly(
     system: System,
     params: SystemParams,
     q_guess,
@@ -31,16 +79,18 @@ def assemble(
     t=0.0,
     inputs: Inputs | None = None,
     iterations: int = 20,
-    throw: bool = True,
-):
+    max_rotation=MAX_BRANCH_ROTATION,
+) -> AssemblyResult:
     """Solve ``Phi(q, t) = 0`` by Newton-Raphson from ``q_guess`` holding ``q[fixed]``.
 
     A fixed number of (minimum-norm) Newton steps, so the result is differentiable in
-    ``params`` and ``q_guess``. With ``throw`` and concrete values, an
-    :class:`AssemblyError` names the worst constraint and its residual.
-    Returns ``q``.
+    ``params`` and ``q_guess`` and works under ``jit`` / ``vmap``; it never raises (see
+    :func:`assemble`) but reports convergence and a jump to another assembly branch: a body
+    rotated by more than ``max_rotation`` (rad) from the guess, or a link whose direction
+    reversed.
     """
     q_guess = jnp.asarray(q_guess, jnp.float64)
+    params = checked_params(system, params)
     t = jnp.asarray(t, q_guess.dtype)
     free = np.setdiff1d(np.arange(system.n_q), np.asarray(fixed, dtype=int))
     u = input_values(system, inputs, t, q_guess.dtype)
@@ -53,18 +103,67 @@ def assemble(
         dq = jnp.linalg.lstsq(jac, r)[0]
         return qf - dq
 
-    qf = jax.lax.fori_loop(0, iterations, step, q_guess[free])
-    q = q_guess.at[free].set(qf)
-    if throw and not isinstance(q, jax.core.Tracer):
-        r = np.abs(np.asarray(constraints(system, params, q, u)))
-        if r.size and (not np.all(np.isfinite(r)) or r.max() > ASSEMBLY_TOL):
-            k = int(np.nanargmax(np.where(np.isfinite(r), r, np.inf)))
-            raise AssemblyError(
-                f"cannot assemble: constraint {system.constraint_names[k]} residual {r[k]:.3e} after "
-                f"{iterations} Newton iterations (tolerance {ASSEMBLY_TOL:g}); check the geometry, "
-                "link lengths and the initial guess"
-            )
-    return q
+    q = q_guess.at[free].set(jax.lax.fori_loop(0, iterations, step, q_guess[free]))
+    finite = jnp.all(jnp.isfinite(q))
+    q = jnp.where(finite, q, q_guess)
+    r = jnp.abs(constraints(system, params, q, u))
+    residual_max = jnp.max(r, initial=0.0)
+    worst = jnp.argmax(r) if r.size else jnp.asarray(0)
+    rotation = _rotation_change(system, params, q_guess, q)
+    flipped = _links_flipped(system, params, q_guess, q, u)
+    ok = finite & (residual_max <= ASSEMBLY_TOL) & (rotation <= max_rotation) & ~flipped
+    return AssemblyResult(q=q, residual=residual_max, worst=worst, rotation=rotation, flipped=flipped, ok=ok)
+
+
+def assembly_message(system: System, result: AssemblyResult, max_rotation=MAX_BRANCH_ROTATION) -> str:
+    """Why an assembly failed, naming the constraint and its gap or the branch jump."""
+    if float(result.residual) > ASSEMBLY_TOL:
+        name = system.constraint_names[int(result.worst)]
+        return (
+            f"cannot assemble: constraint {name} misses by {float(result.residual):.3e} (m or rad; "
+            f"tolerance {ASSEMBLY_TOL:g}); the configuration cannot be reached: check the geometry, "
+            "link lengths, the imposed motion and the initial guess"
+        )
+    if bool(result.flipped):
+        return (
+            "assembly jumped to another branch: a link reversed its direction relative to the initial guess; "
+            "check the link lengths and the initial guess"
+        )
+    return (
+        f"assembly jumped to another branch: a body rotated by {np.degrees(float(result.rotation)):.1f} deg from "
+        f"the initial guess (limit {np.degrees(float(max_rotation)):.1f} deg); check the link lengths, or give a "
+        "closer initial guess"
+    )
+
+
+def assemble(
+    system: System,
+    params: SystemParams,
+    q_guess,
+    fixed: tuple[int, ...] = (),
+    t=0.0,
+    inputs: Inputs | None = None,
+    iterations: int = 20,
+    throw: bool = True,
+    max_rotation=MAX_BRANCH_ROTATION,
+):
+    """Assembled coordinates ``q`` by :func:`solve_assembly`.
+
+    With ``throw`` a failure raises: :class:`AssemblyError` naming the worst constraint and
+    its residual, or the branch jump, for concrete values; a run-time error
+    (``eqx.error_if``) under ``jit``. ``throw=False`` returns the (NaN-free) ``q`` as it is;
+    use :func:`solve_assembly` to get the flags.
+    """
+    result = solve_assembly(system, params, q_guess, fixed, t, inputs, iterations, max_rotation)
+    if not throw:
+        return result.q
+    if is_concrete(result.ok):
+        if not bool(result.ok):
+            raise AssemblyError(assembly_message(system, result, max_rotation))
+        return result.q
+    return eqx.error_if(
+        result.q, ~result.ok, "cannot assemble, or the assembly jumped to another branch (call solve_assembly for why)"
+    )
 
 
 #: ``simulate`` refuses initial coordinates whose constraint residual exceeds this (m or rad).
@@ -226,6 +325,7 @@ def simulate(
     (default 101 points). The wrapper is pure: ``jax.grad`` and ``jax.vmap`` go through it.
     """
     q0, z0 = jnp.asarray(q0, jnp.float64), jnp.asarray(z0, jnp.float64)
+    params = checked_params(system, params)
     ts = jnp.linspace(t0, t1, 101) if ts is None else jnp.asarray(ts, jnp.float64)
     q0 = _check_assembled(system, params, q0, t0, inputs)
     solver = diffrax.Tsit5() if solver is None else solver

@@ -25,7 +25,8 @@ import equinox as eqx
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._core import GRAVITY, ParameterError, float_field
+from .._core import GRAVITY, ParameterError, check_range, float_field
+import jax.numpy as jnp
 from ._bodies import FlexibleBody, FlexOptions, RigidBody
 from ._rotations import SEQUENCES
 
@@ -432,3 +433,53 @@ class SystemBuilder:
             gravity=self._gravity,
         )
         return system, params
+
+
+#: Smallest inertia eigenvalue accepted, relative to the largest (round-off of a PSD tensor).
+INERTIA_PSD_RTOL = 1e-12
+
+
+def _check_inertia(name: str, inertia):
+    """A body's inertia must be symmetric positive semi-definite (kg m^2)."""
+    w = jnp.linalg.eigvalsh(0.5 * (inertia + inertia.T))
+    smallest = w[0] / jnp.maximum(jnp.abs(w[-1]), 1.0)
+    check_range(f"{name} inertia (smallest eigenvalue / largest)", smallest, low=-INERTIA_PSD_RTOL)
+    return check_range(f"{name} inertia", inertia, low=None)
+
+
+def checked_params(system: System, params: SystemParams) -> SystemParams:
+    """``params`` with every number a user (or an optimiser) may change checked: masses
+    >= 0 kg, inertias symmetric positive semi-definite, couplings in [0, 1], link lengths
+    > 0 m, finite point positions and gravity. Concrete values raise
+    :class:`~jaxveh.ParameterError` naming the body, joint or point; traced values fail at
+    run time through ``eqx.error_if``. Called once by :func:`simulate`, :func:`assemble`
+    and :func:`linearise` (not inside the vector field)."""
+    bodies = []
+    for name, body in zip(system.body_names, params.bodies):
+        if isinstance(body, RigidBody):
+            body = eqx.tree_at(
+                lambda b: (b.mass, b.inertia),
+                body,
+                (check_range(f"body {name!r} mass (kg)", body.mass, low=0.0),
+                 _check_inertia(f"body {name!r}", body.inertia)),
+            )
+        else:
+            body = eqx.tree_at(
+                lambda b: b.coupling, body, check_range(f"body {name!r} coupling", body.coupling, low=0.0, high=1.0)
+            )
+        bodies.append(body)
+    joints = []
+    for name, kind, joint in zip(system.joint_names, system.joint_kind, params.joints):
+        if kind == "link":
+            joint = eqx.tree_at(
+                lambda j: j.length, joint, check_range(f"link {name!r} length (m)", joint.length, low=0.0, low_open=True)
+            )
+        joints.append(joint)
+    points = tuple(
+        eqx.tree_at(lambda p: p.position, pt, check_range(f"point {name!r} position (m)", pt.position))
+        for name, pt in zip(system.point_names, params.points)
+    )
+    gravity = check_range("gravity (m/s^2)", params.gravity)
+    return eqx.tree_at(
+        lambda p: (p.bodies, p.joints, p.points, p.gravity), params, (tuple(bodies), tuple(joints), points, gravity)
+    )
