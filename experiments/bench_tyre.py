@@ -43,14 +43,17 @@ def main() -> None:
     pts = [jnp.asarray(x) for x in (rng.uniform(0, 1200, n), rng.uniform(-0.3, 0.3, n),
                                     np.deg2rad(rng.uniform(-15, 15, n)), np.deg2rad(rng.uniform(-3, 3, n)))]
 
-    batched = eqx.filter_jit(lambda t, fz, k, a, g: jax.vmap(tyre_forces, in_axes=(None, 0, 0, 0, 0, None))(t, fz, k, a, g, 11.0))
+    per_point = jax.vmap(tyre_forces, in_axes=(None, 0, 0, 0, 0, None))
+    batched = eqx.filter_jit(lambda t, fz, k, a, g: per_point(t, fz, k, a, g, 11.0))
     t0 = time.perf_counter()
     jax.block_until_ready(batched(tyre, *pts))
     compile_batch = time.perf_counter() - t0
     run_batch = _time(batched, tyre, *pts)
 
-    four = eqx.filter_jit(lambda t, x: jax.vmap(tyre_forces, in_axes=(None, 0, 0, 0, 0, None))(t, x[0], x[1], x[2], x[3], 11.0))
-    x4 = jnp.asarray([[700.0, 650.0, 750.0, 720.0], [0.02, 0.01, 0.05, 0.04], [0.03, 0.02, 0.04, 0.05], [0.0, 0.0, 0.01, -0.01]])
+    four = eqx.filter_jit(lambda t, x: per_point(t, x[0], x[1], x[2], x[3], 11.0))
+    x4 = jnp.asarray(
+        [[700.0, 650.0, 750.0, 720.0], [0.02, 0.01, 0.05, 0.04], [0.03, 0.02, 0.04, 0.05], [0.0, 0.0, 0.01, -0.01]]
+    )
     t0 = time.perf_counter()
     jax.block_until_ready(four(tyre, x4))
     compile_four = time.perf_counter() - t0

@@ -23,9 +23,11 @@ from pathlib import Path
 
 import jax
 import jax.numpy as jnp
+import matplotlib.pyplot as plt
 import numpy as np
 
 import jaxveh  # noqa: F401  (float64)
+from jaxveh import plots
 from jaxveh.analytic import state_space, with_distribution
 from jaxveh.control import preview_controller, preview_distance
 from jaxveh.params import load_analytic_vehicle
@@ -87,8 +89,19 @@ def minimum_mu(lp_fn, asymptote, mu_grid, lp_grid, threshold=THRESHOLD, iteratio
 
 
 def run(out: Path, n_mu: int, vehicle_path: str | None) -> dict:
+    """Compute, write the JSON, CSV files and the PNG into ``out``; return the report."""
     out.mkdir(parents=True, exist_ok=True)
-    vehicle = load_analytic_vehicle(vehicle_path)
+    report, panels = compute(load_analytic_vehicle(vehicle_path), n_mu, out)
+    (out / "fig_3_11_preview.json").write_text(json.dumps(report, indent=2))
+    fig = figure(*panels)
+    fig.savefig(out / "fig_3_11_preview.png", dpi=120)
+    plt.close(fig)
+    return report
+
+
+def compute(vehicle, n_mu: int, out: Path | None = None) -> tuple[dict, tuple]:
+    """The report and the panel data ``(panels_gains, panels_lp, mu_grid)`` of :func:`figure`;
+    CSV files of the curves go into ``out`` when given."""
     mu_grid = np.geomspace(*MU_RANGE, n_mu)
     report = {"thesis": THESIS, "settings": {"dt_s": DT, "n_preview": N_PREVIEW, "q_weight": 1000.0,
                                              "r_weight": 1.0, "filter": "Butterworth 4th order, 2 Hz",
@@ -135,16 +148,15 @@ def run(out: Path, n_mu: int, vehicle_path: str | None) -> dict:
             "dlp_dmu_at_mu1_m": dlp_dmu,
             "sweep_wall_s": sweep_s,
         }
-        _write_csv(out / f"lp_vs_mu_{kmh:g}kmh.csv", ["mu", "lp_m", "lp_interp_m"],
-                   zip(mu_grid, lp[:, 0], lp[:, 1]))
-        _write_csv(out / f"gains_{kmh:g}kmh.csv", ["l_m", "kp_rigid_deg_per_m", "kp_flex_deg_per_m"],
-                   zip(distance, curves["rigid"], curves["flex"]))
+        if out is not None:
+            _write_csv(out / f"lp_vs_mu_{kmh:g}kmh.csv", ["mu", "lp_m", "lp_interp_m"],
+                       zip(mu_grid, lp[:, 0], lp[:, 1]))
+            _write_csv(out / f"gains_{kmh:g}kmh.csv", ["l_m", "kp_rigid_deg_per_m", "kp_flex_deg_per_m"],
+                       zip(distance, curves["rigid"], curves["flex"]))
     report["max_riccati_residual"] = max(d[0] for d in diagnostics)
     report["max_closed_loop_spectral_radius"] = max(d[1] for d in diagnostics)
     report["mu_grid"] = mu_grid.tolist()
-    (out / "fig_3_11_preview.json").write_text(json.dumps(report, indent=2))
-    _plot(out / "fig_3_11_preview.png", panels_gains, panels_lp, mu_grid)
-    return report
+    return report, (panels_gains, panels_lp, mu_grid)
 
 
 def _write_csv(path: Path, header, rows) -> None:
@@ -154,13 +166,9 @@ def _write_csv(path: Path, header, rows) -> None:
         writer.writerows([[f"{x:.10g}" for x in row] for row in rows])
 
 
-def _plot(path: Path, panels_gains, panels_lp, mu_grid) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5))
+def figure(panels_gains, panels_lp, mu_grid):
+    """Fig. 3.11 (a)-(d) (constrained layout)."""
+    fig, axes = plots.figure(2, 2, figsize=(10, 7.5))
     for col, kmh in enumerate(SPEEDS_KMH):
         distance, curves = panels_gains[kmh]
         ax = axes[0, col]
@@ -182,9 +190,7 @@ def _plot(path: Path, panels_gains, panels_lp, mu_grid) -> None:
         ax.legend()
         ax.grid(True, which="both", alpha=0.3)
         ax.set_title(f"({'cd'[col]}) {kmh:g} km/h")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    return fig
 
 
 def main() -> None:

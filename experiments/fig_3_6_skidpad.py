@@ -14,7 +14,8 @@ def main():
     save(plot_skidpad(report), out / "fig_3_6.png")
     write_json(report, out / "fig_3_6.json")
     for name, data in report["variants"].items():
-        print(f"{name:>24}: 1/ku at low ay {data['steering_sensitivity_g_per_deg'][0]:.3f} g/deg, limit {data['ay_limit_g']:.3f} g, "
+        sens = data["steering_sensitivity_g_per_deg"][0]
+        print(f"{name:>24}: 1/ku at low ay {sens:.3f} g/deg, limit {data['ay_limit_g']:.3f} g, "
               f"δd at 1.0 g {next(d for a, d in zip(data['ay_g'], data['delta_dynamic_deg']) if a >= 0.999):.3f} deg")
 
 

@@ -18,7 +18,8 @@ def main():
     save(plot_skidpad(combined, labels={}), out / "fig_3_7.png")
     write_json(combined, out / "fig_3_7.json")
     for name, data in combined["variants"].items():
-        print(f"{name:>18}: 1/ku at low ay {data['steering_sensitivity_g_per_deg'][0]:.3f} g/deg, limit {data['ay_limit_g']:.3f} g")
+        sens = data["steering_sensitivity_g_per_deg"][0]
+        print(f"{name:>18}: 1/ku at low ay {sens:.3f} g/deg, limit {data['ay_limit_g']:.3f} g")
 
 
 if __name__ == "__main__":

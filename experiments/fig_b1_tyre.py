@@ -42,7 +42,8 @@ def main() -> None:
     with (out / "curves.csv").open("w", newline="") as fh:
         w = csv.writer(fh)
         loads = [f"{fz:.0f}" for fz in np.asarray(c.loads)]
-        w.writerow(["kappa", *[f"fx_{f}N" for f in loads], "alpha_deg", *[f"fy_{f}N" for f in loads], *[f"mz_{f}N" for f in loads]])
+        columns = ["kappa", *[f"fx_{f}N" for f in loads], "alpha_deg"]
+        w.writerow(columns + [f"fy_{f}N" for f in loads] + [f"mz_{f}N" for f in loads])
         for j in range(c.kappa.shape[0]):
             w.writerow([float(c.kappa[j]), *np.asarray(c.fx[:, j]).tolist(), float(np.rad2deg(c.alpha[j])),
                         *np.asarray(c.fy[:, j]).tolist(), *np.asarray(c.mz[:, j]).tolist()])
@@ -52,9 +53,11 @@ def main() -> None:
         w.writeheader()
         w.writerows(rows)
     (out / "peaks.json").write_text(json.dumps({"jaxveh": rows, "fig_b1": FIG_B1}, indent=2))
-    print(f"{'Fz':>6} {'Fx max':>8} {'kappa':>6} {'|Fy| max':>9} {'alpha':>6} {'Mz max':>7} {'alpha':>6} {'Mz min':>7} {'alpha':>6}")
+    print(f"{'Fz':>6} {'Fx max':>8} {'kappa':>6} {'|Fy| max':>9} {'alpha':>6} {'Mz max':>7} {'alpha':>6} "
+          f"{'Mz min':>7} {'alpha':>6}")
     for r in rows:
-        print(f"{r['fz']:6.0f} {r['fx_peak']:8.0f} {r['kappa_peak']:6.3f} {r['fy_peak']:9.0f} {r['alpha_peak_deg']:6.2f} "
+        print(f"{r['fz']:6.0f} {r['fx_peak']:8.0f} {r['kappa_peak']:6.3f} {r['fy_peak']:9.0f} "
+              f"{r['alpha_peak_deg']:6.2f} "
               f"{r['mz_max']:7.1f} {r['alpha_mz_max_deg']:6.2f} {r['mz_min']:7.1f} {r['alpha_mz_min_deg']:6.2f}")
     print("Fig. B.1:", FIG_B1)
     print(f"wrote {out}")

@@ -11,13 +11,17 @@ Rockafellar augmented Lagrangian: outer multiplier updates around ``inner_steps`
 steps.
 """
 
-from typing import Callable, NamedTuple, Optional
+import math
+from collections.abc import Callable
+from typing import NamedTuple, Optional
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 import optax
+
+from jaxveh import ParameterError
 
 
 class Variable(NamedTuple):
@@ -30,11 +34,17 @@ class Variable(NamedTuple):
 
 
 def get_leaf(params, path: str):
-    """Leaf of ``params`` at dotted attribute ``path``; ``ValueError`` if it does not exist."""
+    """Leaf of ``params`` at dotted attribute ``path``; ``ParameterError`` (a ``ValueError``)
+    if it does not exist or is a derived property rather than a stored field."""
     node = params
     for part in path.split("."):
+        if isinstance(getattr(type(node), part, None), property):
+            raise ParameterError(
+                f"parameter path {path!r}: {type(node).__name__}.{part} is derived from other fields "
+                f"(a property), not a leaf; vary the fields it is computed from"
+            )
         if not hasattr(node, part):
-            raise ValueError(f"parameter path {path!r}: {type(node).__name__} has no field {part!r}")
+            raise ParameterError(f"parameter path {path!r}: {type(node).__name__} has no field {part!r}")
         node = getattr(node, part)
     return node
 
@@ -70,11 +80,20 @@ class Problem(eqx.Module):
     apply: Optional[Callable] = eqx.field(static=True, default=None)
 
     def __check_init__(self):
+        if not self.variables:
+            raise ParameterError("Problem needs at least one design variable")
+        names = [var.name for var in self.variables]
+        if len(set(names)) != len(names):
+            raise ParameterError(f"design variable names must be unique, got {names}")
         for var in self.variables:
+            if not (math.isfinite(var.lower) and math.isfinite(var.upper)):
+                raise ParameterError(f"variable {var.name!r}: bounds must be finite, got [{var.lower}, {var.upper}]")
             if not var.lower < var.upper:
-                raise ValueError(f"variable {var.name!r}: need lower < upper, got [{var.lower}, {var.upper}]")
+                raise ParameterError(f"variable {var.name!r}: need lower < upper, got [{var.lower}, {var.upper}]")
             if var.log and var.lower <= 0.0:
-                raise ValueError(f"variable {var.name!r}: log scale needs lower > 0, got {var.lower}")
+                raise ParameterError(f"variable {var.name!r}: log scale needs lower > 0, got {var.lower}")
+            if self.apply is None:
+                get_leaf(self.params, var.name)
 
     def to_values(self, z) -> dict:
         """Unconstrained vector ``z`` -> ``{name: value}`` inside the bounds."""
@@ -89,12 +108,18 @@ class Problem(eqx.Module):
 
     def to_z(self, values: dict):
         """Inverse of :meth:`to_values` (values must lie strictly inside the bounds)."""
+        missing = [var.name for var in self.variables if var.name not in values]
+        if missing:
+            raise ParameterError(f"initial values missing for design variable(s) {missing}")
         zs = []
         for var in self.variables:
             x = float(values[var.name])
             if not var.lower < x < var.upper:
-                raise ValueError(f"initial {var.name} = {x} must lie strictly inside ({var.lower}, {var.upper})")
-            s = (np.log(x) - np.log(var.lower)) / (np.log(var.upper) - np.log(var.lower)) if var.log else (x - var.lower) / (var.upper - var.lower)
+                raise ParameterError(f"initial {var.name} = {x} must lie strictly inside ({var.lower}, {var.upper})")
+            if var.log:
+                s = (np.log(x) - np.log(var.lower)) / (np.log(var.upper) - np.log(var.lower))
+            else:
+                s = (x - var.lower) / (var.upper - var.lower)
             zs.append(np.log(s / (1.0 - s)))
         return jnp.asarray(zs)
 
@@ -123,6 +148,19 @@ def _lagrangian(problem: Problem, z, multipliers, rho):
     return value
 
 
+def _check_settings(*, inner_steps, outer_steps, rho, rho_growth, constraint_tol) -> None:
+    for name, value in (("inner_steps", inner_steps), ("outer_steps", outer_steps)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ParameterError(f"{name} must be a Python int >= 1; got {value!r}")
+    for name, value, ok, allowed in (
+        ("rho", rho, lambda x: x > 0.0, "(0, inf)"),
+        ("rho_growth", rho_growth, lambda x: x >= 1.0, "[1, inf)"),
+        ("constraint_tol", constraint_tol, lambda x: x > 0.0, "(0, inf)"),
+    ):
+        if not (math.isfinite(float(value)) and ok(float(value))):
+            raise ParameterError(f"{name} must lie in {allowed}; got {value!r}")
+
+
 def solve(
     problem: Problem,
     initial: dict,
@@ -138,8 +176,13 @@ def solve(
     Each outer iteration runs ``inner_steps`` optimiser steps on the augmented Lagrangian
     (one compiled ``lax.scan``), then updates multipliers and grows the penalty while the
     worst constraint violation exceeds ``constraint_tol``. Raises ``RuntimeError`` if the
-    objective or gradient becomes non-finite.
+    objective or gradient becomes non-finite. Settings are checked (``ParameterError``):
+    ``inner_steps``, ``outer_steps`` >= 1, ``rho`` > 0, ``rho_growth`` >= 1,
+    ``constraint_tol`` > 0. Parameter values out of their physical range during the solve
+    raise the library's own runtime error (e.g. a vehicle field's allowed range).
     """
+    _check_settings(inner_steps=inner_steps, outer_steps=outer_steps, rho=rho, rho_growth=rho_growth,
+                    constraint_tol=constraint_tol)
     optimiser = optax.adam(0.05) if optimiser is None else optimiser
     z = problem.to_z(initial)
     n_con = len(problem.constraints)
@@ -174,14 +217,23 @@ def solve(
         if not bool(jnp.all(jnp.isfinite(values))) or not bool(jnp.all(jnp.isfinite(z))):
             raise RuntimeError("optimisation produced a non-finite objective or design; check bounds and the objective")
         obj, cons = evaluate(z)
-        history.append({"objective": float(obj), "max_violation": float(jnp.max(cons, initial=0.0)), **{k: float(v) for k, v in problem.to_values(z).items()}})
+        values = {k: float(v) for k, v in problem.to_values(z).items()}
+        history.append({"objective": float(obj), "max_violation": float(jnp.max(cons, initial=0.0)), **values})
         if n_con == 0:
             break
         multipliers = jnp.maximum(0.0, multipliers + rho * cons)
         if float(jnp.max(cons, initial=0.0)) > constraint_tol:
             rho = rho * rho_growth
-        elif len(history) > 1 and abs(history[-1]["objective"] - history[-2]["objective"]) <= 1e-9 * max(1.0, abs(history[-1]["objective"])):
+        elif len(history) > 1 and abs(history[-1]["objective"] - history[-2]["objective"]) <= 1e-9 * max(
+            1.0, abs(history[-1]["objective"])
+        ):
             break
     obj, cons = evaluate(z)
     values = {k: float(v) for k, v in problem.to_values(z).items()}
-    return Result(values=values, params=problem.build(z), objective=float(obj), constraints=[float(c) for c in cons], history=history)
+    return Result(
+        values=values,
+        params=problem.build(z),
+        objective=float(obj),
+        constraints=[float(c) for c in cons],
+        history=history,
+    )

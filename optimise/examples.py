@@ -40,7 +40,8 @@ def minimum_chassis_stiffness(vehicle=None, max_error=0.02, lam_range=(0.3, 0.7)
         constraints=(lambda v: worst_load_transfer_error(v, lam_range) / max_error - 1.0,),
     )
     result = solve(problem, {"kC": 10.0 * float(k_total)}, optax.adam(0.05), inner_steps=400, outer_steps=12)
-    return {"mu": result.values["kC"] / float(k_total), "kC_Nm_per_deg": result.values["kC"] * jnp.pi / 180.0, "result": result}
+    kc = result.values["kC"]
+    return {"mu": kc / float(k_total), "kC_Nm_per_deg": kc * jnp.pi / 180.0, "result": result}
 
 
 def roll_distribution_for_understeer(target_deg_per_g, vehicle=None, mu=1.0):
@@ -62,6 +63,9 @@ def roll_distribution_for_understeer(target_deg_per_g, vehicle=None, mu=1.0):
 
 if __name__ == "__main__":
     a = minimum_chassis_stiffness()
-    print(f"(a) minimum µ for 2 % load-transfer error over λ = 0.3-0.7: {a['mu']:.3f} (kC = {float(a['kC_Nm_per_deg']):.0f} Nm/deg); thesis ≈ 3")
+    print(
+        f"(a) minimum µ for 2 % load-transfer error over λ = 0.3-0.7: {a['mu']:.3f} "
+        f"(kC = {float(a['kC_Nm_per_deg']):.0f} Nm/deg); thesis ≈ 3"
+    )
     b = roll_distribution_for_understeer(0.80)
     print(f"(b) λ for ku = 0.80 deg/g at µ = 1: {b['lam']:.4f} (ku = {b['ku_deg_per_g']:.4f} deg/g)")

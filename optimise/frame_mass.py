@@ -15,6 +15,7 @@ solve and the eigen-solve.
 """
 
 import argparse
+import math
 import time
 from pathlib import Path
 
@@ -24,6 +25,7 @@ import jax.numpy as jnp
 import optax
 
 import jaxveh.fe as fe
+from jaxveh import ParameterError
 
 #: Practical tube limits (as in experiments/fe_tune_frame.py): 15-35 mm diameter,
 #: 0.8-3 mm wall (0.8 mm = 0.032 in, the thinnest common chromoly frame tube).
@@ -69,9 +71,17 @@ def minimise_frame_mass(
         k_target: minimum torsional stiffness (Nm/deg, thesis test set-up).
         f_target: minimum first free-free frequency (Hz).
         steps: Adam steps per penalty phase; phases: number of penalty weights (x10 each).
+        Targets and the learning rate must be > 0, ``steps`` and ``phases`` ints >= 1
+        (``ParameterError``).
     """
     if not all(isinstance(s, fe.CircularTube) for s in frame.sections):
         raise ValueError("minimise_frame_mass handles circular tubes only")
+    for name, value in (("k_target", k_target), ("f_target", f_target), ("learning_rate", learning_rate)):
+        if not (math.isfinite(float(value)) and float(value) > 0.0):
+            raise ParameterError(f"{name} must lie in (0, inf); got {value!r}")
+    for name, value in (("steps", steps), ("phases", phases)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ParameterError(f"{name} must be a Python int >= 1; got {value!r}")
     x = (
         _inverse(jnp.stack([s.diameter for s in frame.sections]), *D_BOUNDS),
         _inverse(jnp.stack([s.thickness for s in frame.sections]), *T_BOUNDS),
@@ -98,7 +108,10 @@ def minimise_frame_mass(
             x, state, (m, k, f1) = step(x, state, weight)
             history.append((float(m), float(k), float(f1)))
             if verbose and (i % 10 == 0 or i == steps - 1):
-                print(f"phase {phase} step {i:3d}: mass {float(m):6.2f} kg  k {float(k):6.1f} Nm/deg  f1 {float(f1):6.2f} Hz")
+                print(
+                    f"phase {phase} step {i:3d}: mass {float(m):6.2f} kg  k {float(k):6.1f} Nm/deg  "
+                    f"f1 {float(f1):6.2f} Hz"
+                )
     return _frame(frame, x), history
 
 

@@ -5,6 +5,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import central_difference
 
 from jaxveh.analytic import (
     FLEXIBLE,
@@ -23,8 +24,6 @@ from jaxveh.analytic import (
 from jaxveh.analytic._model import PF, PHIF, PHIR, PR, R, V
 from jaxveh.analytic._transient import Trajectory
 from jaxveh.params import load_analytic_vehicle
-
-from helpers import central_difference
 
 
 @pytest.fixture(scope="module")

@@ -16,8 +16,8 @@ from jaxveh.analytic import (
     state_space,
     understeer_gradient,
     understeer_gradient_rigid,
-    vehicle_modes,
     vector_field,
+    vehicle_modes,
     with_distribution,
 )
 from jaxveh.analytic._linear import _rigid_embedding
@@ -102,7 +102,8 @@ def test_frequency_response_against_scipy(vehicle):
     freqs = np.geomspace(0.1, 5.0, 7)
     c = np.zeros((1, a.shape[0]))
     c[0, 3] = 1.0  # yaw rate
-    _, h = scipy.signal.freqresp(scipy.signal.StateSpace(np.asarray(a), np.asarray(b) * float(vehicle.k_stw), c, np.zeros((1, 1))), 2 * np.pi * freqs)
+    system = scipy.signal.StateSpace(np.asarray(a), np.asarray(b) * float(vehicle.k_stw), c, np.zeros((1, 1)))
+    _, h = scipy.signal.freqresp(system, 2 * np.pi * freqs)
     ours = np.asarray(frequency_response(vehicle, speed, freqs)["yaw_rate"])
     np.testing.assert_allclose(ours, h, rtol=1e-10)
 

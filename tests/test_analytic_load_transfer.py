@@ -4,6 +4,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import central_difference
 
 from jaxveh.analytic import (
     chi,
@@ -17,8 +18,6 @@ from jaxveh.analytic import (
 )
 from jaxveh.analytic._quantities import roll_moments, sprung_split
 from jaxveh.params import load_analytic_vehicle
-
-from helpers import central_difference
 
 #: Closed forms evaluated in float64: agreement to round-off.
 EXACT = 1e-12
@@ -97,7 +96,10 @@ def test_sensitivity_gradient_against_finite_differences(vehicle):
         assert float(g) == pytest.approx(fd, rel=1e-7)
     # Gradient with respect to the chassis stiffness kC (Nm/rad).
     g_kc = jax.grad(lambda kc: chi(with_distribution(v, lam=0.3, mu=kc / (v.kF + v.kR))))(v.kC)
-    fd_kc = central_difference(lambda x: chi(with_distribution(v, lam=0.3, mu=x[0] / (v.kF + v.kR))), np.array([float(v.kC)]), 1.0)[0]
+    def chi_of_kc(x):
+        return chi(with_distribution(v, lam=0.3, mu=x[0] / (v.kF + v.kR)))
+
+    fd_kc = central_difference(chi_of_kc, np.array([float(v.kC)]), 1.0)[0]
     assert float(g_kc) == pytest.approx(fd_kc, rel=1e-6)
 
 

@@ -3,6 +3,7 @@
 import jax
 import numpy as np
 import pytest
+from helpers import central_difference
 
 from jaxveh.analytic import (
     RAD_PER_MS2_TO_DEG_PER_G,
@@ -16,8 +17,6 @@ from jaxveh.analytic import (
 )
 from jaxveh.analytic._quantities import roll_moments
 from jaxveh.params import load_analytic_vehicle
-
-from helpers import central_difference
 
 EXACT = 1e-12
 

@@ -46,7 +46,9 @@ def test_step_steer_contract():
 
 
 def test_map_writes_plot_and_json(tmp_path):
-    out = _json(["analytic", "map", "--quantity", "ku_error", "--n-lam", "5", "--n-mu", "4", "--json", "--out", str(tmp_path)])
+    args = ["analytic", "map", "--quantity", "ku_error", "--n-lam", "5", "--n-mu", "4", "--json"]
+    args += ["--out", str(tmp_path)]
+    out = _json(args)
     assert len(out["values"]) == 5 and len(out["values"][0]) == 4
     assert (tmp_path / "map_ku_error.png").stat().st_size > 1000
     assert (tmp_path / "map_ku_error.json").exists()
@@ -56,7 +58,10 @@ def test_map_writes_plot_and_json(tmp_path):
     "args,message",
     [
         (["analytic", "lltd", "--lam", "1.5"], "lam (roll stiffness proportion kF/(kF+kR)) must be in (0, 1)"),
-        (["analytic", "understeer", "--mu", "-1"], "mu (normalised chassis torsional stiffness kC/(kF+kR)) must be > 0"),
+        (
+            ["analytic", "understeer", "--mu", "-1"],
+            "mu (normalised chassis torsional stiffness kC/(kF+kR)) must be > 0",
+        ),
         (["analytic", "eig", "--speed-kmh", "0"], "speed_kmh must be > 0"),
         (["analytic", "map", "--quantity", "grip"], "quantity must be one of"),
         (["analytic", "lltd", "--vehicle", "missing.toml"], "vehicle file 'missing.toml' does not exist"),

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 import scipy.signal
-
 from helpers import assert_grad_matches_fd
+
 from jaxveh.control import zoh
 
 #: expm via Pade in both libraries; agreement to a few ulps of the entries' scale.

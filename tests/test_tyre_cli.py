@@ -36,7 +36,8 @@ def test_eval_with_tir_and_speed():
     out = _json(args)
     t = jt.read_tir(FIXTURE)
     ref = jt.tyre_forces(t, 3000.0, -0.05, jnp.deg2rad(-2.0), jnp.deg2rad(1.5), 25.0)
-    np.testing.assert_allclose([out[k] for k in ("fx", "fy", "mz", "mx", "my")], list(ref[:2]) + [ref.mz, ref.mx, ref.my], rtol=1e-14)
+    got = [out[k] for k in ("fx", "fy", "mz", "mx", "my")]
+    np.testing.assert_allclose(got, list(ref[:2]) + [ref.mz, ref.mx, ref.my], rtol=1e-14)
 
 
 @pytest.mark.parametrize(

@@ -35,13 +35,17 @@ def _synthetic(combined: bool, seed: int = 0) -> jt.TyreMeasurements:
     cols = [jnp.asarray(r[:, i]) for i in range(4)]
     f = jax.jit(jax.vmap(jt.tyre_forces, in_axes=(None, 0, 0, 0, 0, None)))(TRUE, *cols, 11.0)
     sd = NOISE * r[:, 0]
-    noisy = [np.asarray(v) + s * rng.standard_normal(len(r)) for v, s in ((f.fx, sd), (f.fy, sd), (f.mz, 0.1 * 0.254 * sd))]
+    noisy = [
+        np.asarray(v) + s * rng.standard_normal(len(r)) for v, s in ((f.fx, sd), (f.fy, sd), (f.mz, 0.1 * 0.254 * sd))
+    ]
     return jt.TyreMeasurements(*cols, *(jnp.asarray(v) for v in noisy), jnp.full(len(r), 11.0))
 
 
 def _perturbed(names):
     return eqx.tree_at(
-        lambda t: [getattr(t, n) for n in names], TRUE, [getattr(TRUE, n) * (1.15 if i % 2 else 0.87) for i, n in enumerate(names)]
+        lambda t: [getattr(t, n) for n in names],
+        TRUE,
+        [getattr(TRUE, n) * (1.15 if i % 2 else 0.87) for i, n in enumerate(names)],
     )
 
 
@@ -66,7 +70,10 @@ def test_pure_lateral_refit_recovers_coefficients():
 
 @pytest.mark.slow
 def test_all_stages_refit_recovers_curves(tmp_path):
-    names = ("pcx1", "pdx1", "pdx2", "pkx1", "pcy1", "pdy1", "pdy2", "pky1", "pky2", "qbz1", "qcz1", "qdz1", "qdz6", "rbx1", "rby1")
+    names = (
+        "pcx1", "pdx1", "pdx2", "pkx1", "pcy1", "pdy1", "pdy2", "pky1", "pky2", "qbz1", "qcz1", "qdz1", "qdz6", "rbx1",
+        "rby1",
+    )
     data = _synthetic(combined=True, seed=1)
     path = jt.write_tyre_csv(tmp_path / "data.csv", data)
     data = jt.read_tyre_csv(path)  # through the CSV format

@@ -9,10 +9,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import central_difference
 
 import jaxveh.tyre as jt
 from jaxveh.params import as_float
-from helpers import central_difference
 
 FSAE = jt.load_fsae_tyre()
 FIXTURE = jt.read_tir(Path(__file__).parent / "data" / "tyre_mf52_fixture.tir")
@@ -93,7 +93,8 @@ def _np_fy0(t, fz, alpha, gamma):
     c = g["pcy1"] * g["lcy"]
     d = (g["pdy1"] + g["pdy2"] * dfz) * (1 - g["pdy3"] * gy**2) * g["lmuy"] * fz
     e = min((g["pey1"] + g["pey2"] * dfz) * (1 - (g["pey3"] + g["pey4"] * gy) * np.sign(ay)) * g["ley"], 1.0)
-    k = g["pky1"] * g["fnomin"] * np.sin(2 * np.arctan(fz / (g["pky2"] * fz0))) * (1 - g["pky3"] * abs(gy)) * g["lfzo"] * g["lky"]
+    k = g["pky1"] * g["fnomin"] * np.sin(2 * np.arctan(fz / (g["pky2"] * fz0)))
+    k = k * (1 - g["pky3"] * abs(gy)) * g["lfzo"] * g["lky"]
     b = k / (c * d)
     sv = fz * ((g["pvy1"] + g["pvy2"] * dfz) * g["lvy"] + (g["pvy3"] + g["pvy4"] * dfz) * gy) * g["lmuy"]
     return d * np.sin(c * np.arctan(b * ay - e * (b * ay - np.arctan(b * ay)))) + sv
@@ -101,7 +102,8 @@ def _np_fy0(t, fz, alpha, gamma):
 
 def test_pure_lateral_matches_independent_numpy():
     for fz, a, g in [(3500.0, 0.05, 0.0), (2000.0, -0.12, 0.03), (5000.0, 0.3, -0.05)]:
-        np.testing.assert_allclose(float(FORCES(FIXTURE, *_pt(fz, 0.0, a, g, 20.0)).fy), _np_fy0(FIXTURE, fz, a, g), rtol=1e-12)
+        fy = float(FORCES(FIXTURE, *_pt(fz, 0.0, a, g, 20.0)).fy)
+        np.testing.assert_allclose(fy, _np_fy0(FIXTURE, fz, a, g), rtol=1e-12)
 
 
 def test_fig_b1_peaks():
@@ -144,7 +146,8 @@ EXTREME = [1e-300, 1e-12, 0.0, -1e-12, -5.0, 1e6, 1e300, -1e300]
 
 def test_no_nan_for_extreme_finite_inputs():
     vals = jnp.asarray(EXTREME)
-    grid = jnp.stack(jnp.meshgrid(vals, vals, vals, jnp.asarray([-1.0, 0.0, 0.5, 1e300]), vals, indexing="ij"), -1).reshape(-1, 5)
+    mesh = jnp.meshgrid(vals, vals, vals, jnp.asarray([-1.0, 0.0, 0.5, 1e300]), vals, indexing="ij")
+    grid = jnp.stack(mesh, -1).reshape(-1, 5)
     for tyre in (FSAE, FIXTURE):
         f = GRID(tyre, grid[:, 0], grid[:, 1], grid[:, 2], grid[:, 3], grid[:, 4])
         for v in f:
@@ -186,7 +189,8 @@ def test_continuity_through_zero_slip_and_speed():
     s = jnp.linspace(-1e-6, 1e-6, 201)
     n = s.shape[0]
     fz, z = jnp.full(n, 700.0), jnp.zeros(n)
-    for f in (GRID(FSAE, fz, s, s, z, jnp.full(n, 11.0)), GRID(FIXTURE, fz * 5, s, s, z, jnp.full(n, 11.0)), GRID(FIXTURE, fz * 5, z, z, z, s)):
+    v11 = jnp.full(n, 11.0)
+    for f in (GRID(FSAE, fz, s, s, z, v11), GRID(FIXTURE, fz * 5, s, s, z, v11), GRID(FIXTURE, fz * 5, z, z, z, s)):
         for v in f:
             assert np.abs(np.diff(np.asarray(v))).max() < 1e-2
 
@@ -239,7 +243,8 @@ def test_vmap_over_loads_and_over_tyres(tmp_path):
         np.testing.assert_allclose(per_tyre.fy[i], FORCES(t, *_pt(600.0, 0.0, 0.15)).fy, rtol=1e-13)
     assert float(per_tyre.fy[1]) < float(per_tyre.fy[0]) < 0.0  # more grip, more (negative) force
     # tyres from different files (different static extras) stack with stack_tyres
-    both = jt.stack_tyres([FIXTURE, jt.read_tir(jt.write_tir(tmp_path / "f.tir", dataclasses.replace(FIXTURE, extras=())))])
+    written = jt.write_tir(tmp_path / "f.tir", dataclasses.replace(FIXTURE, extras=()))
+    both = jt.stack_tyres([FIXTURE, jt.read_tir(written)])
     fy = jax.vmap(lambda t: jt.tyre_forces(t, 3000.0, 0.02, 0.05, 0.01, 20.0).fy)(both)
     np.testing.assert_allclose(fy[0], fy[1], rtol=1e-14)
     with pytest.raises(ValueError, match="differ in"):

@@ -8,9 +8,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import assert_grad_matches_fd
 
 import jaxveh.tyre as jt
-from helpers import assert_grad_matches_fd
 
 FSAE = jt.load_fsae_tyre()
 FIXTURE = jt.read_tir(Path(__file__).parent / "data" / "tyre_mf52_fixture.tir")
@@ -112,7 +112,8 @@ def test_axes_mapping_round_trip_and_signs():
     force, moment = jt.forces_to_vehicle(f, 700.0, delta)
     # rotating back into the wheel frame recovers the ISO-W components
     c, s = np.cos(delta), np.sin(delta)
-    np.testing.assert_allclose([c * force[0] + s * force[1], -s * force[0] + c * force[1], force[2]], [300.0, -800.0, 700.0], rtol=1e-14)
+    in_wheel_axes = [c * force[0] + s * force[1], -s * force[0] + c * force[1], force[2]]
+    np.testing.assert_allclose(in_wheel_axes, [300.0, -800.0, 700.0], rtol=1e-14)
     np.testing.assert_allclose(moment[2], 20.0)
     np.testing.assert_allclose(np.linalg.norm(force[:2]), np.hypot(300.0, -800.0), rtol=1e-14)
     # a wheel steered left (delta > 0) on a car going straight slides right: negative alpha,

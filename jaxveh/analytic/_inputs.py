@@ -6,7 +6,7 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ..params import float_field
+from ..params import Range, checked_field
 
 
 class AbstractSteer(eqx.Module):
@@ -20,7 +20,7 @@ class AbstractSteer(eqx.Module):
 class ConstantSteer(AbstractSteer):
     """δ(t) = angle (rad)."""
 
-    angle: Float[Array, ""] = float_field()
+    angle: Float[Array, ""] = checked_field("ConstantSteer.angle", Range(what="road-wheel steer angle, rad"))
 
     def __call__(self, t):
         return self.angle + 0.0 * t
@@ -30,12 +30,13 @@ class SmoothStep(AbstractSteer):
     """Cubic smoothed step: 0 before ``start``, ``amplitude`` after ``start + rise`` (rad, s).
 
     δ = A (3 s^2 - 2 s^3), s = (t - start)/rise clipped to [0, 1]: continuous first
-    derivative, as in section 3.3.3.
+    derivative, as in section 3.3.3. ``rise`` must be > 0 (it divides), the others not NaN;
+    checked on construction (``ParameterError``; traced values: ``eqx.error_if``).
     """
 
-    amplitude: Float[Array, ""] = float_field()
-    start: Float[Array, ""] = float_field()
-    rise: Float[Array, ""] = float_field()
+    amplitude: Float[Array, ""] = checked_field("SmoothStep.amplitude", Range(what="steer amplitude, rad"))
+    start: Float[Array, ""] = checked_field("SmoothStep.start", Range(what="start time, s"))
+    rise: Float[Array, ""] = checked_field("SmoothStep.rise", Range(0.0, low_open=True, what="rise time, s"))
 
     def __call__(self, t):
         s = jnp.clip((t - self.start) / self.rise, 0.0, 1.0)

@@ -10,7 +10,23 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from ..params import AnalyticVehicle
-from ._model import FLEXIBLE, PF, PHIF, PHIR, PR, PSI, RIGID, RIGID_ROLL_MAP, N_STATES, R, V, Y, mass_matrix, vector_field
+from ._checks import check_speed
+from ._model import (
+    FLEXIBLE,
+    N_STATES,
+    PF,
+    PHIF,
+    PHIR,
+    PR,
+    PSI,
+    RIGID,
+    RIGID_ROLL_MAP,
+    R,
+    V,
+    Y,
+    mass_matrix,
+    vector_field,
+)
 from ._quantities import roll_moments
 from ._roll_steer import axle_cornering_stiffness
 
@@ -21,7 +37,8 @@ _TO_NONLINEAR = (Y, PSI, PHIF, PHIR, V, R, PF, PR)
 
 
 def second_order_matrices(vehicle: AnalyticVehicle, speed):
-    """M, T, K, D, Y of eqs. (3.31)-(3.35) for the flexible chassis (SI units)."""
+    """M, T, K, D, Y of eqs. (3.31)-(3.35) for the flexible chassis (SI units), speed u > 0 (m/s)."""
+    speed = check_speed(speed)
     mF, mR = roll_moments(vehicle)
     cF, cR = axle_cornering_stiffness(vehicle)
     a, b, u = vehicle.a, vehicle.b, speed
@@ -63,7 +80,7 @@ def state_space(vehicle: AnalyticVehicle, speed, rigid: bool = False):
     ``rigid=True`` returns the 6-state rigid-chassis model (projection φF = φR).
     B is per unit steering-wheel angle (rad).
     """
-    m, t, k, d, y = second_order_matrices(vehicle, jnp.asarray(speed, dtype=jnp.float64))
+    m, t, k, d, y = second_order_matrices(vehicle, speed)
     if rigid:
         p = RIGID_ROLL_MAP
         m, t, k, d, y = p.T @ m @ p, jnp.linalg.pinv(p) @ t @ p, p.T @ k @ p, p.T @ d @ p, p.T @ y
@@ -75,7 +92,7 @@ def linearise(vehicle: AnalyticVehicle, speed, rigid: bool = False):
 
     Same states and input as :func:`state_space`; the two must agree.
     """
-    speed = jnp.asarray(speed, dtype=jnp.float64)
+    speed = check_speed(speed)
     variant = RIGID if rigid else FLEXIBLE
     index = jnp.asarray(_TO_NONLINEAR)
 

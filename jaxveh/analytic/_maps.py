@@ -4,7 +4,7 @@
 chassis torsional stiffness; the total roll stiffness kF + kR is held at the vehicle's value.
 """
 
-from typing import Callable
+from collections.abc import Callable
 
 import equinox as eqx
 import jax
@@ -12,7 +12,8 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import AnalyticVehicle
+from ..params import AnalyticVehicle, ParameterError, Range, check, check_analytic_vehicle, check_int, check_static
+from ._checks import LAM, MU
 from ._load_transfer import chi, chi_rigid, chi_sensitivity
 from ._quantities import with_distribution
 from ._roll_steer import RAD_PER_MS2_TO_DEG_PER_G, understeer_gradient, understeer_gradient_rigid
@@ -60,14 +61,18 @@ def get_quantity(name: str) -> Callable[[AnalyticVehicle], Float[Array, ""]]:
 
 
 def design_map(vehicle: AnalyticVehicle, quantity: str, lam_values, mu_values) -> Float[Array, "n_lam n_mu"]:
-    """``quantity`` on the grid λ x µ (rows λ, columns µ), one nested-vmap call."""
+    """``quantity`` on the grid λ x µ (rows λ, columns µ), one nested-vmap call.
+
+    λ values must lie in [0, 1] and µ values be > 0 (``ParameterError``).
+    """
     fn = get_quantity(quantity)
+    vehicle = check_analytic_vehicle(vehicle)
 
     def at(lam, mu):
         return fn(with_distribution(vehicle, lam=lam, mu=mu))
 
-    lam_values = jnp.asarray(lam_values, dtype=jnp.float64)
-    mu_values = jnp.asarray(mu_values, dtype=jnp.float64)
+    lam_values = check("lam_values", lam_values, LAM)
+    mu_values = check("mu_values", mu_values, MU)
     return jax.vmap(lambda lam: jax.vmap(lambda mu: at(lam, mu))(mu_values))(lam_values)
 
 
@@ -75,6 +80,14 @@ def design_map(vehicle: AnalyticVehicle, quantity: str, lam_values, mu_values) -
 def _worst_error(vehicle: AnalyticVehicle, quantity: str, lam_values, mu) -> Float[Array, ""]:
     fn = get_quantity(quantity)
     return jnp.max(jax.vmap(lambda lam: fn(with_distribution(vehicle, lam=lam, mu=mu)))(lam_values))
+
+
+def _interval(name: str, bounds, rng: Range) -> tuple[float, float]:
+    """``(low, high)`` inside ``rng`` with low < high (``ParameterError`` otherwise)."""
+    low, high = (check_static(name, x, rng) for x in bounds)
+    if not low < high:
+        raise ParameterError(f"{name} must satisfy low < high; got ({low:g}, {high:g})")
+    return low, high
 
 
 def minimum_stiffness(
@@ -94,9 +107,15 @@ def minimum_stiffness(
     corresponding kC (Nm/deg) and the worst error there.
     """
     if not quantity.endswith("error"):
-        raise ValueError(f"quantity must be an error map ({[q for q in MAP_QUANTITIES if q.endswith('error')]}), got {quantity!r}")
+        errors = [q for q in MAP_QUANTITIES if q.endswith("error")]
+        raise ValueError(f"quantity must be an error map ({errors}), got {quantity!r}")
     if not 0.0 < threshold < 1.0:
         raise ValueError(f"threshold must be a relative error in (0, 1), got {threshold}")
+    vehicle = check_analytic_vehicle(vehicle)
+    lam_range = _interval("lam_range", lam_range, LAM)
+    mu_bounds = _interval("mu_bounds", mu_bounds, MU)
+    n_lam = check_int("n_lam", n_lam, 2)
+    check_static("rtol", rtol, Range(0.0, low_open=True, what="relative tolerance on µ"))
     lam_values = jnp.linspace(lam_range[0], lam_range[1], n_lam)
 
     def worst(mu):

@@ -5,7 +5,8 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Complex
 
-from ..params import AnalyticVehicle
+from ..params import AnalyticVehicle, Range, check
+from ._checks import check_speed
 from ._linear import dynamic_subsystem, state_space
 from ._quantities import GRAVITY
 
@@ -17,7 +18,7 @@ def _velocity_indices(rigid: bool) -> tuple[int, int]:
     return (1, 2) if rigid else (2, 3)
 
 
-def eigenvalues(vehicle: AnalyticVehicle, speed, rigid: bool = False) -> Complex[Array, "n"]:
+def eigenvalues(vehicle: AnalyticVehicle, speed, rigid: bool = False) -> Complex[Array, " n"]:
     """Eigenvalues (1/s) of the dynamic subsystem (Y and ψ removed), eq. (3.37)."""
     a, _ = dynamic_subsystem(*state_space(vehicle, speed, rigid))
     return jnp.linalg.eigvals(a)
@@ -71,18 +72,19 @@ def frequency_response(vehicle: AnalyticVehicle, speed, freqs_hz, rigid: bool = 
 
     Returns complex arrays ``yaw_rate`` (1/s, i.e. rad/s per rad) and ``ay`` (g per deg),
     per road-wheel angle (``per_road_wheel=True``, the scale of Fig. 3.10) or per
-    steering-wheel angle.
+    steering-wheel angle. ``speed`` u > 0 (m/s) and ``freqs_hz`` >= 0 (Hz) are checked.
     """
+    speed = check_speed(speed)
+    freqs_hz = check("freqs_hz", freqs_hz, Range(0.0, what="frequency, Hz"))
     a, b = dynamic_subsystem(*state_space(vehicle, speed, rigid))
     if per_road_wheel:
         b = b * vehicle.k_stw
     n = a.shape[0]
     i_v, i_r = _velocity_indices(rigid)
-    speed = jnp.asarray(speed, dtype=jnp.float64)
     c_yaw = jnp.zeros(n).at[i_r].set(1.0)
     c_ay = a[i_v] + speed * c_yaw  # ay = dv/dt + u r
     d_ay = b[i_v, 0]
-    s = 2j * jnp.pi * jnp.asarray(freqs_hz, dtype=jnp.float64).astype(jnp.complex128)
+    s = 2j * jnp.pi * freqs_hz.astype(jnp.complex128)
     a_c, b_c = a.astype(jnp.complex128), b[:, 0].astype(jnp.complex128)
     c_yaw_c, c_ay_c = c_yaw.astype(jnp.complex128), c_ay.astype(jnp.complex128)
 

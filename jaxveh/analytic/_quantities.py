@@ -5,13 +5,11 @@ All lengths in m, masses in kg, stiffnesses in Nm/rad. The roll stiffness propor
 """
 
 import equinox as eqx
-import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ..params import AnalyticVehicle
-
-#: Standard gravity (m/s^2).
-GRAVITY = 9.80665
+from .._core import GRAVITY
+from ..params import AnalyticVehicle, check
+from ._checks import LAM, MU
 
 
 def sprung_split(vehicle: AnalyticVehicle) -> tuple[Float[Array, ""], Float[Array, ""]]:
@@ -58,13 +56,14 @@ def with_distribution(vehicle: AnalyticVehicle, lam=None, mu=None) -> AnalyticVe
 
     The total roll stiffness kF + kR is kept; kF = λ K, kR = (1 - λ) K, kC = µ K.
     ``None`` keeps the vehicle's own value. Differentiable in ``lam`` and ``mu``.
+    λ must lie in [0, 1] and µ be > 0 (``ParameterError``; traced: ``eqx.error_if``).
     """
     k_total = total_roll_stiffness(vehicle)
     if lam is not None:
-        lam = jnp.asarray(lam, dtype=jnp.float64)
+        lam = check("lam", lam, LAM)
         vehicle = eqx.tree_at(lambda v: (v.kF, v.kR), vehicle, (lam * k_total, (1.0 - lam) * k_total))
     if mu is not None:
-        mu = jnp.asarray(mu, dtype=jnp.float64)
+        mu = check("mu", mu, MU)
         vehicle = eqx.tree_at(lambda v: v.kC, vehicle, mu * k_total)
     return vehicle
 
@@ -77,5 +76,5 @@ def roll_gradient(vehicle: AnalyticVehicle) -> Float[Array, ""]:
 
 def static_tyre_loads(vehicle: AnalyticVehicle) -> tuple[Float[Array, ""], Float[Array, ""]]:
     """Static vertical load of one front and one rear tyre (N)."""
-    l = vehicle.a + vehicle.b
-    return vehicle.m * GRAVITY * vehicle.b / (2.0 * l), vehicle.m * GRAVITY * vehicle.a / (2.0 * l)
+    weight = vehicle.m * GRAVITY
+    return weight * vehicle.b / (2.0 * vehicle.l), weight * vehicle.a / (2.0 * vehicle.l)

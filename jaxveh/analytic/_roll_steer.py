@@ -66,8 +66,7 @@ def chassis_twist(vehicle: AnalyticVehicle, ay) -> Float[Array, ""]:
 
 def _tyre_term(vehicle: AnalyticVehicle) -> Float[Array, ""]:
     cF, cR = axle_cornering_stiffness(vehicle)
-    l = vehicle.a + vehicle.b
-    return vehicle.m / l * (vehicle.b / cF - vehicle.a / cR)
+    return vehicle.m / vehicle.l * (vehicle.b / cF - vehicle.a / cR)
 
 
 def understeer_gradient_rigid(vehicle: AnalyticVehicle) -> Float[Array, ""]:

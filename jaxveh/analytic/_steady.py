@@ -13,10 +13,11 @@ import jax.numpy as jnp
 import optimistix as optx
 from jaxtyping import Array, Float
 
-from ..params import AnalyticVehicle
+from ..params import AnalyticVehicle, Range, check
+from ._checks import LATERAL_ACCELERATION
 from ._model import N_STATES, PF, PHIF, PHIR, PR, R, V, Variant, generalised_forces, vector_field
-from ._roll_steer import understeer_gradient, understeer_gradient_rigid
 from ._quantities import roll_gradient
+from ._roll_steer import understeer_gradient, understeer_gradient_rigid
 
 #: [v, r, pF, pR, phiF, phiR] = E @ [v, r, p, phi] for the rigid chassis.
 _RIGID_EMBEDDING = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0, 0, 0, 1))
@@ -25,6 +26,12 @@ _RIGID_EMBEDDING = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 1, 0), (0, 
 NEWTON_RTOL = 1e-10
 NEWTON_ATOL = 1e-12
 NEWTON_MAX_STEPS = 64
+#: Skid-pad circle radius (m).
+RADIUS = Range(0.0, low_open=True, what="skid-pad circle radius, m")
+
+
+def _check_inputs(ay, radius):
+    return check("ay", ay, LATERAL_ACCELERATION), check("radius", radius, RADIUS)
 
 
 class SteadyState(eqx.Module):
@@ -65,14 +72,20 @@ def _initial_guess(vehicle: AnalyticVehicle, ay, radius, variant: Variant):
     return jnp.stack([0.0 * ay, (vehicle.a + vehicle.b) / radius + ku * ay, phi, phi])
 
 
-def skidpad_steady_state(vehicle: AnalyticVehicle, ay, variant: Variant, radius=50.0, throw: bool = True) -> SteadyState:
+def skidpad_steady_state(
+    vehicle: AnalyticVehicle, ay, variant: Variant, radius=50.0, throw: bool = True
+) -> SteadyState:
     """Steady state on a circle of ``radius`` (m) at lateral acceleration ``ay`` (m/s^2).
 
     With ``throw=True`` a failed Newton solve (e.g. ay above the vehicle's grip limit)
     raises an error; with ``throw=False`` the result's ``converged`` flag says so.
+    ``ay`` and ``radius`` must be > 0 (``ParameterError``; traced: ``eqx.error_if``).
     """
-    ay = jnp.asarray(ay, dtype=jnp.float64)
-    radius = jnp.asarray(radius, dtype=jnp.float64)
+    ay, radius = _check_inputs(ay, radius)
+    return _steady_state(vehicle, ay, variant, radius, throw)
+
+
+def _steady_state(vehicle: AnalyticVehicle, ay, variant: Variant, radius, throw: bool) -> SteadyState:
     solver = optx.Newton(rtol=NEWTON_RTOL, atol=NEWTON_ATOL)
     sol = optx.root_find(
         _residual,
@@ -120,8 +133,12 @@ def _is_stable(vehicle: AnalyticVehicle, w, speed, radius, variant: Variant) -> 
 
 
 def steering_sensitivity(vehicle: AnalyticVehicle, ay, variant: Variant, radius=50.0) -> Float[Array, ""]:
-    """1/ku = d ay / d δd (m/s^2 per rad) along the skid-pad curve, by implicit differentiation."""
-    d_delta = jax.grad(lambda a: skidpad_steady_state(vehicle, a, variant, radius).delta)(jnp.asarray(ay, dtype=jnp.float64))
+    """1/ku = d ay / d δd (m/s^2 per rad) along the skid-pad curve, by implicit differentiation.
+
+    ``ay`` (m/s^2) and ``radius`` (m) must be > 0.
+    """
+    ay, radius = _check_inputs(ay, radius)
+    d_delta = jax.grad(lambda a: _steady_state(vehicle, a, variant, radius, True).delta)(ay)
     return 1.0 / d_delta
 
 
@@ -140,16 +157,17 @@ def skidpad_sweep(vehicle: AnalyticVehicle, ay_values, variant: Variant, radius=
     One vmapped call. Points where Newton's method fails (ay above the grip limit) have
     ``converged = False`` and NaN values; points on the unstable branch beyond an axle's
     force peak have ``stable = False``. Callers select ``converged & stable`` points (the
-    reports do, and give the highest such ay as the limit).
+    reports do, and give the highest such ay as the limit). Every ay and the radius must
+    be > 0 (``ParameterError``; traced: ``eqx.error_if``).
     """
-    radius = jnp.asarray(radius, dtype=jnp.float64)
+    ay_values, radius = _check_inputs(ay_values, radius)
 
     def one(ay):
-        state = skidpad_steady_state(vehicle, ay, variant, radius, throw=False)
+        state = _steady_state(vehicle, ay, variant, radius, throw=False)
         sens = _sensitivity_at(vehicle, state, variant, radius)
         nan = jnp.nan
         state = jax.tree.map(lambda x: jnp.where(state.converged, x, nan) if x.dtype == jnp.float64 else x, state)
         state = eqx.tree_at(lambda s: s.stable, state, state.stable & state.converged)
         return state, jnp.where(state.converged, sens, nan)
 
-    return jax.vmap(one)(jnp.asarray(ay_values, dtype=jnp.float64))
+    return jax.vmap(one)(ay_values)

@@ -6,7 +6,9 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import AnalyticVehicle
+from .._core import GRAVITY
+from ..params import POSITIVE, AnalyticVehicle, ParameterError, Range, check, check_int, check_static
+from ._checks import check_speed
 from ._inputs import AbstractSteer, SmoothStep
 from ._model import N_STATES, PHIF, PHIR, R, Variant, lateral_acceleration, vector_field
 
@@ -41,9 +43,23 @@ def simulate(
     a straight line) over [0, ``t_end``] s; ``n_save`` evenly spaced outputs.
 
     A failed solve raises Diffrax's error (max steps reached, step size too small, NaN).
+    Inputs are checked (``ParameterError``; traced values: ``eqx.error_if``): ``speed`` > 0,
+    ``t_end`` > 0, ``n_save`` >= 2, ``rtol``, ``atol`` > 0, ``max_steps`` >= 1, ``y0`` not NaN
+    with 9 entries.
     """
-    speed = jnp.asarray(speed, dtype=jnp.float64)
-    y0 = jnp.zeros(N_STATES) if y0 is None else jnp.asarray(y0, dtype=jnp.float64)
+    speed = check_speed(speed)
+    t_end = check("t_end", t_end, Range(0.0, low_open=True, what="end time, s"))
+    n_save = check_int("n_save", n_save, 2, "number of saved times")
+    max_steps = check_int("max_steps", max_steps, 1)
+    for name, tol in (("rtol", rtol), ("atol", atol)):
+        check_static(name, tol, POSITIVE)
+    if y0 is None:
+        y0 = jnp.zeros(N_STATES)
+    else:
+        y0 = jnp.asarray(y0, dtype=jnp.float64)
+        if y0.shape != (N_STATES,):
+            raise ParameterError(f"y0 must have shape ({N_STATES},) (the state of STATE_NAMES); got {y0.shape}")
+        y0 = check("y0", y0, Range(what="initial state, SI units"))
     ts = jnp.linspace(0.0, t_end, n_save)
 
     def rhs(t, y, args):
@@ -93,9 +109,11 @@ def step_steer_metrics(traj: Trajectory, steer: SmoothStep, settle_window: float
     ISO 7401's: from 50 % of the steer input to 90 % of the steady yaw rate. Overshoot is
     (peak - steady)/steady of the yaw rate. Twist settling time is measured from the start
     of the steer input until φC = φF - φR stays within 2 % of its steady value (None when
-    the chassis does not twist).
+    the chassis does not twist). ``settle_window`` must lie in (0, duration of ``traj``) s.
     """
     ts = np.asarray(traj.ts)
+    check("settle_window", settle_window, Range(0.0, float(ts[-1] - ts[0]), low_open=True, high_open=True,
+                                                 what="averaging window at the end of the trajectory, s"))
     tail = ts >= ts[-1] - settle_window
     r = np.asarray(traj.states[:, R])
     twist = np.asarray(traj.states[:, PHIF] - traj.states[:, PHIR])
@@ -109,7 +127,7 @@ def step_steer_metrics(traj: Trajectory, steer: SmoothStep, settle_window: float
         "yaw_rate_peak_time_s": float(ts[np.argmax(r)]) - t_half_input,
         "yaw_rate_overshoot_pct": 100.0 * (r.max() - r_ss) / r_ss,
         "yaw_rate_steady_deg_s": float(np.degrees(r_ss)),
-        "ay_steady_g": ay_ss / 9.80665,
+        "ay_steady_g": ay_ss / GRAVITY,
         "twist_steady_deg": float(np.degrees(twist_ss)),
         "twist_settling_time_s": twist_settling,
     }

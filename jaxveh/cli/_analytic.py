@@ -14,8 +14,12 @@ from ._common import emit_json, fail, write_json
 app = typer.Typer(help="Chapter-3 analytic models (Appendix A vehicle by default).", no_args_is_help=True)
 
 VehicleOpt = typer.Option(None, "--vehicle", help="Appendix-A-style TOML file (default: shipped appendix_a.toml).")
-LamOpt = typer.Option(None, "--lam", help="Roll stiffness proportion λ = kF/(kF+kR), in (0, 1). Default: from the file.")
-MuOpt = typer.Option(None, "--mu", help="Normalised chassis torsional stiffness µ = kC/(kF+kR), > 0. Default: from the file.")
+LamOpt = typer.Option(
+    None, "--lam", help="Roll stiffness proportion λ = kF/(kF+kR), in (0, 1). Default: from the file."
+)
+MuOpt = typer.Option(
+    None, "--mu", help="Normalised chassis torsional stiffness µ = kC/(kF+kR), > 0. Default: from the file."
+)
 JsonOpt = typer.Option(False, "--json", help="Print a machine-readable JSON result on stdout.")
 PlotOpt = typer.Option(None, "--plot", help="Write a PNG figure to this file.")
 OutOpt = typer.Option(None, "--out", help="Write JSON data (and a PNG) into this folder.")
@@ -46,13 +50,23 @@ def _finish(result: dict, as_json: bool, out: Optional[Path], name: str, summary
 
 
 @app.command()
-def lltd(vehicle: Optional[Path] = VehicleOpt, lam: Optional[float] = LamOpt, mu: Optional[float] = MuOpt, as_json: bool = JsonOpt):
+def lltd(
+    vehicle: Optional[Path] = VehicleOpt,
+    lam: Optional[float] = LamOpt,
+    mu: Optional[float] = MuOpt,
+    as_json: bool = JsonOpt,
+):
     """Lateral load transfer proportion χ (eq. 3.6), rigid χ0 (3.3), ζ (3.7) and ∂χ/∂λ."""
     _finish(reports.lltd_report(_vehicle(vehicle, lam, mu)), as_json, None, "lltd")
 
 
 @app.command()
-def understeer(vehicle: Optional[Path] = VehicleOpt, lam: Optional[float] = LamOpt, mu: Optional[float] = MuOpt, as_json: bool = JsonOpt):
+def understeer(
+    vehicle: Optional[Path] = VehicleOpt,
+    lam: Optional[float] = LamOpt,
+    mu: Optional[float] = MuOpt,
+    as_json: bool = JsonOpt,
+):
     """Linear understeer gradient with roll steer, flexible (3.16) and rigid (3.11), deg/g."""
     _finish(reports.understeer_report(_vehicle(vehicle, lam, mu)), as_json, None, "understeer")
 
@@ -139,7 +153,9 @@ def bode(
     f_min: float = typer.Option(0.1, "--f-min", help="Lowest frequency (Hz)."),
     f_max: float = typer.Option(5.0, "--f-max", help="Highest frequency (Hz)."),
     n: int = typer.Option(200, help="Number of frequencies (log-spaced)."),
-    steering_wheel: bool = typer.Option(False, "--steering-wheel", help="Per steering-wheel angle instead of road-wheel angle."),
+    steering_wheel: bool = typer.Option(
+        False, "--steering-wheel", help="Per steering-wheel angle instead of road-wheel angle."
+    ),
     as_json: bool = JsonOpt,
     plot: Optional[Path] = PlotOpt,
     out: Optional[Path] = OutOpt,
@@ -149,7 +165,10 @@ def bode(
     if plot is not None or out is not None:
         save(plot_bode(result), plot if plot is not None else Path(out) / "bode.png")
     summary = {
-        name: {"yaw_rate_db_at_fmin": result[name]["yaw_rate_db_per_s"][0], "ay_db_at_fmin": result[name]["ay_db_g_per_deg"][0]}
+        name: {
+            "yaw_rate_db_at_fmin": result[name]["yaw_rate_db_per_s"][0],
+            "ay_db_at_fmin": result[name]["ay_db_g_per_deg"][0],
+        }
         for name in ("rigid", "flexible")
     }
     _finish(result, as_json, out, "bode", summary)
@@ -174,7 +193,10 @@ def preview(
     if as_json:
         emit_json(result)
     else:
-        typer.echo(f"preview distance Lp = {result['preview_distance_m']:.2f} m at {speed_kmh:g} km/h (Riccati residual {result['riccati_residual']:.1e})")
+        typer.echo(
+            f"preview distance Lp = {result['preview_distance_m']:.2f} m at {speed_kmh:g} km/h "
+            f"(Riccati residual {result['riccati_residual']:.1e})"
+        )
 
 
 @app.command("map")

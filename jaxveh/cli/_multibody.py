@@ -4,7 +4,9 @@ import typer
 
 from ._common import emit_json, fail
 
-app = typer.Typer(help="Flexible multibody library (thesis chapter 5): inspect built-in examples.", no_args_is_help=True)
+app = typer.Typer(
+    help="Flexible multibody library (thesis chapter 5): inspect built-in examples.", no_args_is_help=True
+)
 
 _VALUE_OPTIONS = ("--q", "--qdot")
 

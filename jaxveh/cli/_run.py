@@ -47,7 +47,8 @@ def run(
     skid = reports.skidpad_report(veh)
     write_json(skid, out / "skidpad.json")
     for name, data in skid["variants"].items():
-        _write_csv(out / f"skidpad_{name}.csv", {k: data[k] for k in ("ay_g", "delta_dynamic_deg", "steering_sensitivity_g_per_deg", "phi_front_deg", "phi_rear_deg")})
+        keys = ("ay_g", "delta_dynamic_deg", "steering_sensitivity_g_per_deg", "phi_front_deg", "phi_rear_deg")
+        _write_csv(out / f"skidpad_{name}.csv", {k: data[k] for k in keys})
     save(plot_skidpad(skid), out / "skidpad.png")
     summary["skidpad_ay_limit_g"] = {name: data["ay_limit_g"] for name, data in skid["variants"].items()}
     typer.echo("  step steer (90 km/h, 1.5 deg) ...", err=True)
@@ -55,7 +56,9 @@ def run(
     for name in ("rigid", "flexible"):
         _write_csv(out / f"step_steer_{name}.csv", step[name]["history"])
     save(plot_step_steer(step), out / "step_steer.png")
-    summary["step_steer_90kmh"] = {name: {k: v for k, v in step[name].items() if k != "history"} for name in ("rigid", "flexible")}
+    summary["step_steer_90kmh"] = {
+        name: {k: v for k, v in step[name].items() if k != "history"} for name in ("rigid", "flexible")
+    }
     typer.echo("  frequency response (50 km/h) ...", err=True)
     bode = reports.bode_report(veh)
     write_json(bode, out / "bode.json")
@@ -66,7 +69,13 @@ def run(
         emit_json(summary)
     else:
         lt, us = summary["load_transfer"], summary["understeer"]
-        typer.echo(f"chi = {lt['chi']:.4f} (rigid {lt['chi_rigid']:.4f}), ku = {us['ku_deg_per_g']:.3f} deg/g (rigid {us['ku_rigid_deg_per_g']:.3f})")
+        typer.echo(
+            f"chi = {lt['chi']:.4f} (rigid {lt['chi_rigid']:.4f}), "
+            f"ku = {us['ku_deg_per_g']:.3f} deg/g (rigid {us['ku_rigid_deg_per_g']:.3f})"
+        )
         for name, m in summary["step_steer_90kmh"].items():
-            typer.echo(f"step steer {name:>8}: yaw-rate response {m['yaw_rate_response_time_s']:.3f} s, overshoot {m['yaw_rate_overshoot_pct']:.1f} %, ay {m['ay_steady_g']:.3f} g")
+            typer.echo(
+                f"step steer {name:>8}: yaw-rate response {m['yaw_rate_response_time_s']:.3f} s, "
+                f"overshoot {m['yaw_rate_overshoot_pct']:.1f} %, ay {m['ay_steady_g']:.3f} g"
+            )
         typer.echo(f"wrote {out}/summary.json, CSV and PNG files in {summary['wall_time_s']:.1f} s")

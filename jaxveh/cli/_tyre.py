@@ -50,9 +50,10 @@ def evaluate(
     from ..tyre import tyre_forces
 
     t = _tyre(tir)
-    args = [_finite(v, o) for v, o in ((fz, "--fz"), (kappa, "--kappa"), (alpha_deg, "--alpha-deg"), (gamma_deg, "--gamma-deg"))]
+    options = ((fz, "--fz"), (kappa, "--kappa"), (alpha_deg, "--alpha-deg"), (gamma_deg, "--gamma-deg"))
+    fz_, kappa_, alpha_, gamma_ = (jnp.asarray(_finite(v, o)) for v, o in options)
     speed = None if vx is None else jnp.asarray(_finite(vx, "--vx"))
-    f = tyre_forces(t, jnp.asarray(args[0]), jnp.asarray(args[1]), jnp.deg2rad(jnp.asarray(args[2])), jnp.deg2rad(jnp.asarray(args[3])), speed)
+    f = tyre_forces(t, fz_, kappa_, jnp.deg2rad(alpha_), jnp.deg2rad(gamma_), speed)
     result = {"fx": float(f.fx), "fy": float(f.fy), "mz": float(f.mz)}
     if moments:
         result.update(mx=float(f.mx), my=float(f.my))
@@ -65,7 +66,9 @@ def evaluate(
 
 
 LoadsOpt = typer.Option(
-    None, "--loads", help="Comma-separated loads [N], each > 0 (default: FNOMIN x 1/3, 2/3, 1, 4/3 = Fig. B.1's 250-1000 N for FSAE)."
+    None,
+    "--loads",
+    help="Comma-separated loads [N], each > 0 (default: FNOMIN x 1/3, 2/3, 1, 4/3 = Fig. B.1's 250-1000 N for FSAE).",
 )
 
 
@@ -108,7 +111,10 @@ def peaks(tir: Optional[Path] = TirOpt, loads: Optional[str] = LoadsOpt, as_json
     if as_json:
         emit_json(rows)
         return
-    typer.echo(f"{'Fz [N]':>7} {'Fx max [N]':>10} {'kappa':>6} {'|Fy| max [N]':>12} {'alpha [deg]':>11} {'Mz max [Nm]':>11} {'alpha [deg]':>11}")
+    typer.echo(
+        f"{'Fz [N]':>7} {'Fx max [N]':>10} {'kappa':>6} {'|Fy| max [N]':>12} {'alpha [deg]':>11} "
+        f"{'Mz max [Nm]':>11} {'alpha [deg]':>11}"
+    )
     for r in rows:
         typer.echo(
             f"{r['fz']:7.0f} {r['fx_peak']:10.0f} {r['kappa_peak']:6.3f} {r['fy_peak']:12.0f} "
@@ -118,9 +124,13 @@ def peaks(tir: Optional[Path] = TirOpt, loads: Optional[str] = LoadsOpt, as_json
 
 @app.command()
 def fit(
-    data: Path = typer.Argument(..., help="CSV: fz, kappa, alpha (or alpha_deg), gamma (or gamma_deg), fx, fy, mz [, vx, pressure]."),
+    data: Path = typer.Argument(
+        ..., help="CSV: fz, kappa, alpha (or alpha_deg), gamma (or gamma_deg), fx, fy, mz [, vx, pressure]."
+    ),
     out: Path = typer.Option(..., "--out", help="Fitted .tir file to write."),
-    start: Optional[Path] = typer.Option(None, "--start", help="Initial .tir (default: shipped FSAE tyre, FNOMIN = median load)."),
+    start: Optional[Path] = typer.Option(
+        None, "--start", help="Initial .tir (default: shipped FSAE tyre, FNOMIN = median load)."
+    ),
     max_steps: int = typer.Option(400, "--max-steps", help="Levenberg-Marquardt steps per stage, >= 1."),
     as_json: bool = JsonOpt,
 ):

@@ -5,22 +5,24 @@ Generic: nothing here knows about vehicles. A vehicle model supplies continuous-
 ``(a_c, b_c)`` and the output row selecting the lateral position.
 """
 
+# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
+# ruff: noqa: I001
 from ._butterworth import (
     DiscreteStateSpace as DiscreteStateSpace,
     butterworth_lowpass as butterworth_lowpass,
 )
 from ._discretise import zoh as zoh
-from ._riccati import (
-    RESULTS as RESULTS,
-    DareSolution as DareSolution,
-    riccati_gain as riccati_gain,
-    riccati_residual as riccati_residual,
-    solve_dare as solve_dare,
-)
 from ._preview import (
     PreviewGains as PreviewGains,
     PreviewPlant as PreviewPlant,
     preview_controller as preview_controller,
     preview_distance as preview_distance,
     preview_plant as preview_plant,
+)
+from ._riccati import (
+    RESULTS as RESULTS,
+    DareSolution as DareSolution,
+    riccati_gain as riccati_gain,
+    riccati_residual as riccati_residual,
+    solve_dare as solve_dare,
 )

@@ -6,6 +6,13 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
+from ..params import Range, check, check_int
+
+#: Sample time (s) of every discrete-time block.
+SAMPLE_TIME = Range(0.0, low_open=True, what="sample time, s")
+_CUTOFF = Range(0.0, low_open=True, what="cut-off frequency, Hz")
+_NYQUIST = Range(0.0, 0.5, low_open=True, high_open=True, what="cut-off below the Nyquist frequency 1/(2 dt)")
+
 
 class DiscreteStateSpace(eqx.Module):
     """``x[k+1] = a x[k] + b u[k]``, ``y[k] = c x[k] + d u[k]`` (single input, single output).
@@ -71,18 +78,14 @@ def butterworth_lowpass(
 
     **Arguments:** ``order`` (static Python int >= 1), ``cutoff_hz`` in Hz (below the
     Nyquist frequency ``1/(2 dt)``), ``dt`` the sample time in s. Differentiable in
-    ``cutoff_hz`` and ``dt``.
+    ``cutoff_hz`` and ``dt``. Bad values raise ``ParameterError`` naming the argument and
+    its allowed range (``eqx.error_if`` when traced).
     """
-    if not isinstance(order, int) or order < 1:
-        raise ValueError(f"butterworth_lowpass: order must be a Python int >= 1, got {order!r}.")
-    cutoff_hz = jnp.asarray(cutoff_hz, dtype=jnp.float64)
-    dt = jnp.asarray(dt, dtype=jnp.float64)
-    cutoff_hz = eqx.error_if(
-        cutoff_hz,
-        (cutoff_hz <= 0.0) | (cutoff_hz * dt >= 0.5) | (dt <= 0.0),
-        "butterworth_lowpass: need dt > 0 and 0 < cutoff_hz < 1/(2 dt) (Nyquist).",
-    )
-    omega_c = 2.0 / dt * jnp.tan(jnp.pi * cutoff_hz * dt)
+    order = check_int("butterworth_lowpass: order", order, 1, "static filter order")
+    dt = check("butterworth_lowpass: dt", dt, SAMPLE_TIME)
+    cutoff_hz = check("butterworth_lowpass: cutoff_hz", cutoff_hz, _CUTOFF)
+    ratio = check("butterworth_lowpass: cutoff_hz * dt", cutoff_hz * dt, _NYQUIST)
+    omega_c = 2.0 / dt * jnp.tan(jnp.pi * ratio)
     a, b, c = _analog_prototype(order, omega_c)
     eye = jnp.eye(order)
     half = 0.5 * dt

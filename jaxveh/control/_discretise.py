@@ -4,6 +4,9 @@ import jax.numpy as jnp
 import jax.scipy.linalg as jsl
 from jaxtyping import Array, Float
 
+from ..params import check
+from ._butterworth import SAMPLE_TIME
+
 
 def zoh(
     a_c: Float[Array, "n n"], b_c: Float[Array, "n m"], dt: Float[Array, ""] | float
@@ -29,7 +32,7 @@ def zoh(
             f"zoh: b_c must have shape (n, m) with n = {a_c.shape[0]}, got {b_c.shape}."
         )
     n, m = b_c.shape
-    dt = jnp.asarray(dt, dtype=a_c.dtype)
+    dt = check("zoh: dt", dt, SAMPLE_TIME)
     top = jnp.concatenate([a_c, b_c], axis=1)
     augmented = jnp.concatenate([top, jnp.zeros((m, n + m), dtype=a_c.dtype)], axis=0)
     phi = jsl.expm(augmented * dt)

@@ -19,9 +19,15 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ._butterworth import butterworth_lowpass
+from ..params import Range, check, check_int, check_static
+from ._butterworth import SAMPLE_TIME, butterworth_lowpass
 from ._discretise import zoh
 from ._riccati import RESULTS, solve_dare
+
+#: Share of the area under |Kp| that defines the preview distance (3.46).
+_FRACTION = Range(0.0, 1.0, low_open=True, what="share of the area under |Kp|")
+#: Weights Q and R of the cost (3.43).
+_WEIGHT = Range(0.0, low_open=True, what="cost weight (3.43)")
 
 
 class PreviewPlant(eqx.Module):
@@ -85,6 +91,9 @@ def preview_plant(
     - ``c_y`` (n,): row selecting the lateral position (m) from the model state (``Cd``).
     - ``dt``: sample time (s); ``n_preview`` (static): number of preview points ``q``;
       ``cutoff_hz``, ``filter_order`` (static): Butterworth road filter.
+
+    ``dt`` > 0, ``n_preview`` >= 1, ``filter_order`` >= 1 and ``0 < cutoff_hz < 1/(2 dt)``
+    are checked (``ParameterError``; traced values: ``eqx.error_if``).
     """
     a_c = jnp.asarray(a_c)
     b_c = jnp.asarray(b_c)
@@ -97,8 +106,7 @@ def preview_plant(
             f"preview_plant: need a_c ({n}, {n}), b_c ({n}, 1) and c_y ({n},); got "
             f"{a_c.shape}, {b_c.shape}, {c_y.shape}."
         )
-    if not isinstance(n_preview, int) or n_preview < 1:
-        raise ValueError(f"preview_plant: n_preview must be a Python int >= 1, got {n_preview!r}.")
+    n_preview = check_int("preview_plant: n_preview", n_preview, 1, "static number of preview points")
     a_d, b_d = zoh(a_c, b_c, dt)
     road = butterworth_lowpass(filter_order, cutoff_hz, dt)
     a_r, b_r = _shift_register(n_preview)
@@ -140,13 +148,14 @@ def preview_controller(
     over a batch of models. ``throw`` as in :func:`jaxveh.control.solve_dare`.
 
     Arguments as :func:`preview_plant`; ``q_weight`` (1/m^2) and ``r_weight`` (1/rad^2)
-    are the scalar weights of eq. (3.43).
+    are the scalar weights of eq. (3.43), both > 0 (``ParameterError``, or ``eqx.error_if``
+    when traced).
     """
     plant = preview_plant(
         a_c, b_c, c_y, dt=dt, n_preview=n_preview, cutoff_hz=cutoff_hz, filter_order=filter_order
     )
-    q = jnp.asarray(q_weight, dtype=plant.a.dtype) * (plant.c.T @ plant.c)
-    r = jnp.asarray(r_weight, dtype=plant.a.dtype).reshape(1, 1)
+    q = check("preview_controller: q_weight", q_weight, _WEIGHT) * (plant.c.T @ plant.c)
+    r = check("preview_controller: r_weight", r_weight, _WEIGHT).reshape(1, 1)
     solution = solve_dare(plant.a, plant.b, q, r, throw=throw)
     k = solution.k[0]
     nf, nv = plant.n_filter, plant.n_vehicle
@@ -181,8 +190,12 @@ def preview_distance(
     crossing linearly between ``n - 1`` and ``n``, which makes ``Lp`` continuous and
     differentiable in the gains (useful for sweeps and optimisation).
 
-    **Arguments:** ``preview`` the gains (any unit), ``speed`` ``u`` in m/s, ``dt`` in s.
+    **Arguments:** ``preview`` the gains (any unit), ``speed`` ``u`` in m/s (> 0), ``dt`` in
+    s (> 0), ``fraction`` in (0, 1].
     """
+    speed = check("preview_distance: speed", speed, Range(0.0, low_open=True, what="forward speed u, m/s"))
+    dt = check("preview_distance: dt", dt, SAMPLE_TIME)
+    check_static("preview_distance: fraction", fraction, _FRACTION)
     magnitude = jnp.abs(jnp.asarray(preview))
     magnitude = eqx.error_if(
         magnitude,
@@ -197,4 +210,4 @@ def preview_distance(
         before = jnp.where(n > 0, cumulative[jnp.maximum(n - 1, 0)], 0.0)
         # magnitude[n] > 0 here: the cumulative sum strictly increased at n.
         index = index - 1.0 + (target - before) / magnitude[n]
-    return index * jnp.asarray(speed, dtype=magnitude.dtype) * jnp.asarray(dt, dtype=magnitude.dtype)
+    return index * speed * dt

@@ -30,6 +30,8 @@ import jax.lax as lax
 import jax.numpy as jnp
 from jaxtyping import Array, Float, Int
 
+from ..params import POSITIVE, check_int, check_static, require
+
 
 class RESULTS(eqx.Enumeration):
     """Outcome of :func:`solve_dare`; each failure carries its message."""
@@ -163,7 +165,8 @@ def solve_dare(
 
     ``x[k+1] = a x[k] + b u[k]``; ``q`` positive semi-definite, ``r`` positive definite
     (both are symmetrised). Differentiable in ``a, b, q, r`` (implicit function theorem;
-    see the module docstring), forward and reverse mode, and vmappable.
+    see the module docstring), forward and reverse mode, and vmappable. An ``r`` that is not
+    positive definite raises ``ParameterError`` (``eqx.error_if`` when traced).
 
     **Arguments:**
 
@@ -185,7 +188,11 @@ def solve_dare(
         raise ValueError(
             f"solve_dare: need q ({n}, {n}) and r ({m}, {m}); got {q.shape}, {r.shape}."
         )
+    rtol = check_static("solve_dare: rtol", rtol, POSITIVE)
+    max_steps = check_int("solve_dare: max_steps", max_steps, 1)
+    stein_doublings = check_int("solve_dare: stein_doublings", stein_doublings, 1)
     q, r = _sym(q), _sym(r)
+    r = require(r, ~(jnp.linalg.eigvalsh(r)[0] > 0.0), "solve_dare: r must be positive definite (eigenvalues > 0)")
     constants = tuple(lax.stop_gradient(x) for x in (a, b, q, r))
     p_star, steps, converged = _sda(*constants, rtol, max_steps)
     residual = jnp.linalg.norm(riccati_residual(*constants, p_star)) / jnp.maximum(

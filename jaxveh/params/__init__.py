@@ -1,9 +1,17 @@
 """Vehicle parameters: Equinox pytrees in SI units, loaded from TOML data files."""
 
+# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
+# ruff: noqa: I001
+from .._core import as_float as as_float, float_field as float_field
 from ._appendix_a import (
+    TYRE_RANGES as TYRE_RANGES,
+    VEHICLE_RANGES as VEHICLE_RANGES,
+    VEHICLE_RELATIONS as VEHICLE_RELATIONS,
     AnalyticVehicle as AnalyticVehicle,
     AxleTyre as AxleTyre,
     analytic_vehicle_from_dict as analytic_vehicle_from_dict,
+    check_analytic_vehicle as check_analytic_vehicle,
+    check_axle_tyre as check_axle_tyre,
     load_analytic_vehicle as load_analytic_vehicle,
 )
 from ._appendix_b import (
@@ -19,7 +27,17 @@ from ._appendix_b import (
     load_vehicle_data as load_vehicle_data,
     vehicle_data_from_dict as vehicle_data_from_dict,
 )
-from ._fields import as_float as as_float, float_field as float_field
+from ._checks import (
+    NON_NEGATIVE as NON_NEGATIVE,
+    POSITIVE as POSITIVE,
+    Range as Range,
+    check as check,
+    check_int as check_int,
+    check_module as check_module,
+    check_static as check_static,
+    checked_field as checked_field,
+    require as require,
+)
 from ._schema import (
     UNIT_TO_SI as UNIT_TO_SI,
     ParameterError as ParameterError,

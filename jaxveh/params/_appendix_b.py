@@ -4,9 +4,11 @@ from pathlib import Path
 
 import equinox as eqx
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array, Float
 
-from ._fields import float_field
+from .._core import is_concrete
+from ._checks import Range, check, checked_field, quantity_range
 from ._schema import ParameterError, Quantity, check_sections, read_section, read_toml
 
 HARD_POINT_NAMES = ("A", "B", "C", "D", "E", "F", "H", "L", "M", "P", "Q", "R", "S", "T")
@@ -49,28 +51,58 @@ TYRE = (
 SECTIONS = ("general", "sprung", "unsprung_front", "unsprung_rear", "tyre", "hard_points_front", "hard_points_rear")
 
 
-class RigidBodyData(eqx.Module):
-    """Mass (kg) and inertia tensor (kg m^2, body axes x forward, y left, z up) of a body."""
+_GENERAL_RANGES = {q.key: quantity_range(q) for q in GENERAL}
+_TYRE_RANGES = {q.key: quantity_range(q) for q in TYRE}
 
-    mass: Float[Array, ""] = float_field()
-    inertia: Float[Array, "3 3"] = float_field()
+
+def _general(name: str):
+    return checked_field(f"VehicleData.{name}", _GENERAL_RANGES[name])
+
+
+class RigidBodyData(eqx.Module):
+    """Mass (kg) and inertia tensor (kg m^2, body axes x forward, y left, z up) of a body.
+
+    Checked on construction: mass > 0; inertia 3 x 3, symmetric and positive definite.
+    """
+
+    mass: Float[Array, ""] = checked_field("RigidBodyData.mass", Range(0.0, low_open=True, what="mass, kg"))
+    inertia: Float[Array, "3 3"] = checked_field("RigidBodyData.inertia", Range(what="inertia tensor, kg m2"))
+
+    def __check_init__(self):
+        if self.inertia.shape[-2:] != (3, 3):
+            raise ParameterError(f"RigidBodyData.inertia must have shape (3, 3); got {self.inertia.shape}")
+        if is_concrete(self.inertia):
+            j = np.asarray(self.inertia)
+            if not np.allclose(j, np.swapaxes(j, -1, -2)):
+                raise ParameterError("RigidBodyData.inertia must be symmetric")
+            check("RigidBodyData.inertia eigenvalues", np.linalg.eigvalsh(j), Range(0.0, low_open=True,
+                  what="the inertia tensor must be positive definite, kg m2"))
 
 
 class UnsprungData(eqx.Module):
-    """One corner's unsprung mass (upright + wheel) and the wheel's spin inertia."""
+    """One corner's unsprung mass (upright + wheel) and the wheel's spin inertia (kg m^2)."""
 
     body: RigidBodyData
-    wheel_spin_inertia: Float[Array, ""] = float_field()
+    wheel_spin_inertia: Float[Array, ""] = checked_field(
+        "UnsprungData.wheel_spin_inertia", Range(0.0, low_open=True, what="wheel spin inertia, kg m2")
+    )
 
 
 class CornerHardPoints(eqx.Module):
     """The 14 hard points of a left corner (m), in the corner's local frame.
 
     Local frame: origin on the ground, in the vehicle centre plane, below the axle centre;
-    x forward, y left, z up (Tables B.2, B.3; see docs/assumptions.md).
+    x forward, y left, z up (Tables B.2, B.3; see docs/assumptions.md). Checked on
+    construction: shape (14, 3), finite, every y > 0 (left corner).
     """
 
-    points: Float[Array, "14 3"] = float_field()
+    points: Float[Array, "14 3"] = checked_field("CornerHardPoints.points", Range(what="hard points, m"))
+
+    def __check_init__(self):
+        if self.points.shape[-2:] != (len(HARD_POINT_NAMES), 3):
+            raise ParameterError(f"CornerHardPoints.points must have shape (14, 3); got {self.points.shape}")
+        if is_concrete(self.points):
+            check("CornerHardPoints.points y", self.points[..., 1], Range(0.0, low_open=True, what="left corner, m"))
 
     def __getitem__(self, name: str) -> Float[Array, "3"]:
         return self.points[HARD_POINT_NAMES.index(name)]
@@ -79,24 +111,24 @@ class CornerHardPoints(eqx.Module):
 class TyreData(eqx.Module):
     """Table B.4: vertical stiffness (N/m), damping (Ns/m), relaxation lengths (m)."""
 
-    kz: Float[Array, ""] = float_field()
-    cz: Float[Array, ""] = float_field()
-    sigma_kappa: Float[Array, ""] = float_field()
-    sigma_alpha: Float[Array, ""] = float_field()
+    kz: Float[Array, ""] = checked_field("TyreData.kz", _TYRE_RANGES["kz"])
+    cz: Float[Array, ""] = checked_field("TyreData.cz", _TYRE_RANGES["cz"])
+    sigma_kappa: Float[Array, ""] = checked_field("TyreData.sigma_kappa", _TYRE_RANGES["sigma_kappa"])
+    sigma_alpha: Float[Array, ""] = checked_field("TyreData.sigma_alpha", _TYRE_RANGES["sigma_alpha"])
 
 
 class VehicleData(eqx.Module):
-    """Appendix B data set in SI units (m, kg, rad)."""
+    """Appendix B data set in SI units (m, kg, rad); every number range-checked on construction."""
 
-    a: Float[Array, ""] = float_field()
-    b: Float[Array, ""] = float_field()
-    h_cg: Float[Array, ""] = float_field()
-    track_front: Float[Array, ""] = float_field()
-    track_rear: Float[Array, ""] = float_field()
-    toe_front: Float[Array, ""] = float_field()
-    toe_rear: Float[Array, ""] = float_field()
-    camber_front: Float[Array, ""] = float_field()
-    camber_rear: Float[Array, ""] = float_field()
+    a: Float[Array, ""] = _general("a")
+    b: Float[Array, ""] = _general("b")
+    h_cg: Float[Array, ""] = _general("h_cg")
+    track_front: Float[Array, ""] = _general("track_front")
+    track_rear: Float[Array, ""] = _general("track_rear")
+    toe_front: Float[Array, ""] = _general("toe_front")
+    toe_rear: Float[Array, ""] = _general("toe_rear")
+    camber_front: Float[Array, ""] = _general("camber_front")
+    camber_rear: Float[Array, ""] = _general("camber_rear")
     sprung: RigidBodyData
     unsprung_front: UnsprungData
     unsprung_rear: UnsprungData

@@ -13,7 +13,14 @@ the file, section and key.
 ## Appendix A: the chapter-3 analytic vehicle (`appendix_a.toml`)
 
 Consistency checks: `m = ms + muF + muR`, `l = a + b = as + bs` (c.g. inside the
-wheelbase), `hsF > zF`, `hsR > zR` (relative tolerance 1e-3).
+wheelbase), `a = (ms as + muR l)/m` (unsprung masses at the axles), all to a relative
+tolerance of 1e-3; `hG = (msF hsF + msR hsR + muF huF + muR huR)/m` with `msF = ms bs/l`,
+`msR = ms as/l`, to 2.5 mm (Table A.1 rounds heights to 5 mm); `hsF > zF`, `hsR > zR`.
+`m`, `a`, `b`, `l` and `hG` are checked, not stored: `AnalyticVehicle` computes them from
+the masses, `as`, `bs` and the heights, so they follow any change of those.
+
+The Python API checks the same ranges (SI units) when an `AnalyticVehicle` is built and
+again in every analytic function (see "Input validation" in `docs/analytic.md`).
 
 """
 

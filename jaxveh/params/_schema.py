@@ -7,11 +7,11 @@ against its quantities and returns SI values.
 """
 
 import math
-import tomllib
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from importlib import resources
-from pathlib import Path
-from typing import Mapping, Sequence
+
+from .._core import ParameterError as ParameterError
+from .._core import read_toml as read_toml
 
 #: Factor that converts a value written in the unit to SI.
 UNIT_TO_SI: dict[str, float] = {
@@ -36,10 +36,6 @@ UNIT_TO_SI: dict[str, float] = {
     "Hz": 1.0,
     "s": 1.0,
 }
-
-
-class ParameterError(ValueError):
-    """A vehicle data file or parameter value is missing, unknown or out of range."""
 
 
 @dataclass(frozen=True)
@@ -127,22 +123,3 @@ def schema_markdown(sections: Mapping[str, Sequence[Quantity]]) -> str:
         for q in quantities:
             lines.append(f"| {section} | `{q.key}` | {q.unit} | {q.allowed()} | {q.description} | {q.source} |")
     return "\n".join(lines)
-
-
-def read_toml(path: str | Path | None, package: str, default: str, kind: str) -> tuple[dict, str]:
-    """Parse a user TOML file, or the shipped ``package``/``default`` when ``path`` is None.
-
-    Returns ``(table, where)`` with ``where`` naming the file for error messages. A missing
-    file or invalid TOML raises :class:`ParameterError` naming the ``kind`` of file.
-    """
-    if path is None:
-        text, where = resources.files(package).joinpath(default).read_text(), Path(default).name
-    else:
-        path = Path(path)
-        if not path.is_file():
-            raise ParameterError(f"{kind} file {str(path)!r} does not exist")
-        text, where = path.read_text(), str(path)
-    try:
-        return tomllib.loads(text), where
-    except tomllib.TOMLDecodeError as e:
-        raise ParameterError(f"{where}: not valid TOML ({e})") from None

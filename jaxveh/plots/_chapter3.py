@@ -1,4 +1,9 @@
-"""Figures of chapter 3 drawn from the plain-data reports of :mod:`jaxveh.analytic`."""
+"""Figures of chapter 3 drawn from the plain-data reports of :mod:`jaxveh.analytic`.
+
+Every figure made here uses matplotlib's constrained layout (``layout="constrained"``), so
+titles, axis labels, tick labels and colour bars never overlap; callers that pass their own
+``ax`` should create the figure the same way (:func:`figure`).
+"""
 
 from pathlib import Path
 
@@ -16,6 +21,11 @@ VARIANT_LABELS = {
 }
 
 
+def figure(nrows: int = 1, ncols: int = 1, **kwargs):
+    """``plt.subplots`` with constrained layout: the way every figure of jaxveh is made."""
+    return plt.subplots(nrows, ncols, layout="constrained", **kwargs)
+
+
 def save(fig, path) -> Path:
     """Save ``fig`` as PNG at ``path`` (parents created) and close it."""
     path = Path(path)
@@ -29,7 +39,7 @@ def plot_design_curves(x, curves: dict, xlabel: str, ylabel: str, log_x: bool = 
     """Family of curves ``{label: y}`` over ``x`` (Figs. 3.3a-b, 3.4a-b)."""
     fig = None
     if ax is None:
-        fig, ax = plt.subplots(figsize=(5, 4))
+        fig, ax = figure(figsize=(5, 4))
     for label, y in curves.items():
         ax.plot(x, y, label=label)
     if log_x:
@@ -48,7 +58,7 @@ def plot_map(report: dict, label: str, ax=None, vmax: float | None = None):
     """
     fig = None
     if ax is None:
-        fig, ax = plt.subplots(figsize=(5, 4))
+        fig, ax = figure(figsize=(5, 4))
     mu, lam, values = np.asarray(report["mu"]), np.asarray(report["lam"]), np.asarray(report["values"])
     vmax = float(values.max()) if vmax is None else vmax
     cs = ax.contourf(mu, lam, np.minimum(values, vmax), levels=np.linspace(0.0, vmax, 21), cmap="viridis")
@@ -63,7 +73,7 @@ def plot_map(report: dict, label: str, ax=None, vmax: float | None = None):
 def plot_skidpad(report: dict, labels: dict | None = None):
     """δd and 1/ku versus ay (Figs. 3.6, 3.7) from one or more skid-pad reports' variants."""
     labels = labels or VARIANT_LABELS
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    fig, (ax1, ax2) = figure(1, 2, figsize=(10, 4))
     for name, data in report["variants"].items():
         ax1.plot(data["ay_g"], data["delta_dynamic_deg"], label=labels.get(name, name))
         ax2.plot(data["ay_g"], data["steering_sensitivity_g_per_deg"], label=labels.get(name, name))
@@ -82,7 +92,7 @@ def plot_skidpad(report: dict, labels: dict | None = None):
 
 def plot_step_steer(report: dict):
     """Steer, ay, yaw rate and chassis twist histories, rigid vs flexible (Fig. 3.8)."""
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7))
+    fig, axes = figure(2, 2, figsize=(10, 7))
     keys = (("steer_deg", "δ [deg]"), ("ay_g", "ay [g]"), ("yaw_rate_deg_s", "r [deg/s]"), ("twist_deg", "ϕC [deg]"))
     for ax, (key, ylabel), tag in zip(axes.flat, keys, "abcd"):
         for name, style in (("rigid", "-"), ("flexible", "--")):
@@ -104,7 +114,7 @@ def plot_root_locus(loci: dict, ax=None, title: str = "", mode_labels=()):
     """
     fig = None
     if ax is None:
-        fig, ax = plt.subplots(figsize=(5.5, 4.5))
+        fig, ax = figure(figsize=(5.5, 4.5))
     for k, (label, eig) in enumerate(loci.items()):
         eig = np.asarray(eig)
         ax.plot(eig.real, eig.imag, ".", ms=3, color=f"C{k}")
@@ -133,9 +143,12 @@ def plot_root_locus(loci: dict, ax=None, title: str = "", mode_labels=()):
 
 def plot_bode(report: dict):
     """Magnitude and phase of yaw rate and ay per steer angle, rigid vs flexible (Fig. 3.10)."""
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
+    fig, axes = figure(2, 2, figsize=(10, 7), sharex=True)
     f = report["freq_hz"]
-    cols = (("yaw_rate_db_per_s", "yaw_rate_phase_deg", "dB mag [1/s]"), ("ay_db_g_per_deg", "ay_phase_deg", "dB mag [g/deg]"))
+    cols = (
+        ("yaw_rate_db_per_s", "yaw_rate_phase_deg", "dB mag [1/s]"),
+        ("ay_db_g_per_deg", "ay_phase_deg", "dB mag [g/deg]"),
+    )
     for j, (mag, phase, ylabel) in enumerate(cols):
         for name, style in (("rigid", "-"), ("flexible", "--")):
             label = "rigid" if name == "rigid" else "flex."
@@ -156,7 +169,7 @@ def plot_preview(reports: dict, ax=None):
     """Preview gains Kp (deg/m) versus distance ahead l (m) for labelled reports (Fig. 3.11a-b)."""
     fig = None
     if ax is None:
-        fig, ax = plt.subplots(figsize=(5, 4))
+        fig, ax = figure(figsize=(5, 4))
     for label, report in reports.items():
         ax.plot(report["distance_m"], report["gains"], label=f"{label} (Lp = {report['preview_distance_m']:.1f} m)")
     ax.set_xlabel("l [m]")

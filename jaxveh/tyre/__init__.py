@@ -1,8 +1,14 @@
 """Tyres: Magic Formula 5.2 (PAC2002) in pure JAX, ``.tir`` files, relaxation, fitting.
 
 Sign convention ISO-W (see :mod:`jaxveh.tyre._magic_formula`); the mapping to the vehicle
-axes (x forward, y left, z up) is in :mod:`jaxveh.tyre._axes`.
+axes (x forward, y left, z up) is in :mod:`jaxveh.tyre._axes`. The functions that take a
+tyre check its coefficients first (:func:`check_tyre`); see "Input validation" in
+``docs/tyre.md``.
 """
+
+# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
+# ruff: noqa: I001
+from . import _magic_formula, _transient, _vertical
 
 from ._axes import (
     forces_to_vehicle as forces_to_vehicle,
@@ -11,6 +17,14 @@ from ._axes import (
     velocity_to_wheel as velocity_to_wheel,
 )
 from ._base import AbstractTyre as AbstractTyre, TyreForces as TyreForces
+from ._checks import (
+    MF52_RELAXATION_COEFFICIENTS as MF52_RELAXATION_COEFFICIENTS,
+    NON_NEGATIVE_COEFFICIENTS as NON_NEGATIVE_COEFFICIENTS,
+    POSITIVE_COEFFICIENTS as POSITIVE_COEFFICIENTS,
+    check_tyre as check_tyre,
+    coefficient_ranges as coefficient_ranges,
+    tyre_checked as _tyre_checked,
+)
 from ._curves import (
     PureSlipCurves as PureSlipCurves,
     combined_slip_curves as combined_slip_curves,
@@ -27,14 +41,13 @@ from ._fit import (
     read_tyre_csv as read_tyre_csv,
     write_tyre_csv as write_tyre_csv,
 )
-from ._magic_formula import tyre_forces as tyre_forces
 from ._model import (
     SUPPORTED_FITTYP as SUPPORTED_FITTYP,
     MagicFormulaTyre as MagicFormulaTyre,
     coefficient_names as coefficient_names,
     stack_tyres as stack_tyres,
 )
-from ._plot import PANEL_FILES as PANEL_FILES, plot_fig_b1 as plot_fig_b1
+from ._plot import PANEL_FILES as PANEL_FILES, fig_b1_figures as fig_b1_figures, plot_fig_b1 as plot_fig_b1
 from ._tir import (
     TirError as TirError,
     format_tir as format_tir,
@@ -44,15 +57,13 @@ from ._tir import (
     read_tir as read_tir,
     write_tir as write_tir,
 )
-from ._transient import (
-    low_speed_denominator as low_speed_denominator,
-    relaxation_lengths as relaxation_lengths,
-    steady_slips as steady_slips,
-    transient_slip_rhs as transient_slip_rhs,
-    transient_slips as transient_slips,
-)
-from ._vertical import (
-    effective_rolling_radius as effective_rolling_radius,
-    loaded_radius as loaded_radius,
-    vertical_force as vertical_force,
-)
+from ._transient import low_speed_denominator as low_speed_denominator
+
+tyre_forces = _tyre_checked(_magic_formula.tyre_forces)
+relaxation_lengths = _tyre_checked(_transient.relaxation_lengths)
+steady_slips = _tyre_checked(_transient.steady_slips)
+transient_slip_rhs = _tyre_checked(_transient.transient_slip_rhs)
+transient_slips = _tyre_checked(_transient.transient_slips)
+effective_rolling_radius = _tyre_checked(_vertical.effective_rolling_radius)
+loaded_radius = _tyre_checked(_vertical.loaded_radius)
+vertical_force = _tyre_checked(_vertical.vertical_force)

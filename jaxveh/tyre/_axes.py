@@ -18,14 +18,23 @@ only that yaw rotation, and the convention for camber:
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
+from ..params import require
 from ._base import TyreForces
 
 Scalar = Float[Array, ""]
 
 
+_SIDE_MESSAGE = "side must be +1 (left wheel) or -1 (right wheel)"
+
+
 def inclination_angle(camber: ArrayLike, side: ArrayLike) -> Scalar:
-    """ISO-W inclination [rad] from camber [rad] (top outboard positive); ``side`` = +1 left, -1 right."""
-    return -jnp.asarray(camber, dtype=jnp.float64) * jnp.asarray(side, dtype=jnp.float64)
+    """ISO-W inclination [rad] from camber [rad] (top outboard positive); ``side`` = +1 left, -1 right.
+
+    Any other ``side`` raises ``ParameterError`` (traced: ``eqx.error_if``).
+    """
+    side = jnp.asarray(side, dtype=jnp.float64)
+    side = require(side, jnp.abs(side) != 1.0, _SIDE_MESSAGE)
+    return -jnp.asarray(camber, dtype=jnp.float64) * side
 
 
 def velocity_to_wheel(velocity: Float[Array, "3"], heading: ArrayLike) -> tuple[Scalar, Scalar]:

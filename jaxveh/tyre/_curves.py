@@ -11,8 +11,14 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
+from ..params import Range, check, check_int, check_static
+from ._checks import check_tyre
 from ._magic_formula import tyre_forces
 from ._model import MagicFormulaTyre
+
+_KAPPA_MAX = Range(0.0, low_open=True, what="largest |kappa| of the curves, -")
+_ALPHA_MAX = Range(0.0, 90.0, low_open=True, high_open=True, what="largest |alpha| of the curves, deg")
+_LOAD = Range(what="normal load, N; <= 0 is lift-off (zero force)")
 
 #: Fig. B.1 slip ranges. Its loads, 250/500/750/1000 N, are 1/3, 2/3, 1 and 4/3 of the
 #: shipped tyre's FNOMIN (750 N); :func:`default_loads` applies that rule to any tyre.
@@ -37,9 +43,9 @@ def _sweep(tyre, fz, kappa, alpha, gamma, vx):
 class PureSlipCurves(NamedTuple):
     """Pure-slip curves at several loads: rows are loads, columns slip points."""
 
-    loads: Float[Array, "n_fz"]
-    kappa: Float[Array, "n"]
-    alpha: Float[Array, "n"]
+    loads: Float[Array, " n_fz"]
+    kappa: Float[Array, " n"]
+    alpha: Float[Array, " n"]
     fx: Float[Array, "n_fz n"]
     fy: Float[Array, "n_fz n"]
     mz: Float[Array, "n_fz n"]
@@ -54,8 +60,13 @@ def pure_slip_curves(
     gamma: float = 0.0,
 ) -> PureSlipCurves:
     """Fx(kappa) at alpha = 0, and Fy(alpha), Mz(alpha) at kappa = 0, at each load [N]
-    (default :func:`default_loads`)."""
-    loads = jnp.asarray(default_loads(tyre) if loads is None else loads, dtype=jnp.float64)
+    (default :func:`default_loads`). ``n`` >= 2, ``kappa_max`` > 0 and ``alpha_max_deg`` in
+    (0, 90) are checked."""
+    tyre = check_tyre(tyre)
+    n = check_int("n", n, 2, "points per curve")
+    check_static("kappa_max", kappa_max, _KAPPA_MAX)
+    check_static("alpha_max_deg", alpha_max_deg, _ALPHA_MAX)
+    loads = check("loads", default_loads(tyre) if loads is None else loads, _LOAD)
     kappa = jnp.linspace(-kappa_max, kappa_max, n)
     alpha = jnp.deg2rad(jnp.linspace(-alpha_max_deg, alpha_max_deg, n))
     zero = jnp.zeros_like(kappa)
@@ -73,8 +84,12 @@ def combined_slip_curves(
     kappa_max: float = FIG_B1_KAPPA_MAX,
 ):
     """Fx and Fy over kappa in [-kappa_max, kappa_max] at each slip angle (both signs) [N],
-    at load ``fz`` [N] (default FNOMIN: 750 N for the shipped tyre, as Fig. B.1(d))."""
-    fz = float(tyre.fnomin) if fz is None else fz
+    at load ``fz`` [N] (default FNOMIN: 750 N for the shipped tyre, as Fig. B.1(d)).
+    ``n`` >= 2 and ``kappa_max`` > 0 are checked."""
+    tyre = check_tyre(tyre)
+    n = check_int("n", n, 2, "points per curve")
+    check_static("kappa_max", kappa_max, _KAPPA_MAX)
+    fz = float(tyre.fnomin) if fz is None else check_static("fz", fz, _LOAD)
     a = np.deg2rad(np.asarray(alphas_deg, dtype=np.float64))
     a = jnp.asarray(np.concatenate([-a[::-1], a]))
     kappa = jnp.linspace(-kappa_max, kappa_max, n)

@@ -18,8 +18,9 @@ import numpy as np
 import optimistix as optx
 from jaxtyping import Array, Float
 
-from .._config import check_x64
-from ..params import ParameterError
+from .._core import check_x64
+from ..params import POSITIVE, ParameterError, check_int, check_static
+from ._checks import check_tyre
 from ._magic_formula import tyre_forces
 from ._model import MagicFormulaTyre
 
@@ -36,14 +37,14 @@ PURE_KAPPA = 5.0e-3
 class TyreMeasurements(NamedTuple):
     """Measured tyre data, one row per point, SI units and ISO-W signs."""
 
-    fz: Float[Array, "n"]
-    kappa: Float[Array, "n"]
-    alpha: Float[Array, "n"]
-    gamma: Float[Array, "n"]
-    fx: Float[Array, "n"]
-    fy: Float[Array, "n"]
-    mz: Float[Array, "n"]
-    vx: Float[Array, "n"]
+    fz: Float[Array, " n"]
+    kappa: Float[Array, " n"]
+    alpha: Float[Array, " n"]
+    gamma: Float[Array, " n"]
+    fx: Float[Array, " n"]
+    fy: Float[Array, " n"]
+    mz: Float[Array, " n"]
+    vx: Float[Array, " n"]
 
     def select(self, mask) -> "TyreMeasurements":
         """The rows where ``mask`` is true."""
@@ -119,7 +120,8 @@ def read_tyre_csv(path: str | Path) -> TyreMeasurements:
         raise ParameterError(f"{path}: empty CSV (expected a header with {', '.join(REQUIRED_COLUMNS)})")
     header = [h.strip().lower() for h in rows[0]]
     try:
-        table = np.array([[float(v) for v in r] for r in rows[1:]], dtype=np.float64).reshape(len(rows) - 1, len(header))
+        table = np.array([[float(v) for v in r] for r in rows[1:]], dtype=np.float64)
+        table = table.reshape(len(rows) - 1, len(header))
     except ValueError as err:
         raise ParameterError(f"{path}: every value must be a number ({err})") from None
     if not np.all(np.isfinite(table)):
@@ -134,17 +136,19 @@ def read_tyre_csv(path: str | Path) -> TyreMeasurements:
     if table.shape[0] == 0:
         raise ParameterError(f"{path}: no data rows")
     if "pressure" in cols and np.ptp(cols["pressure"]) > 0.01 * np.abs(cols["pressure"]).max():
-        warnings.warn("MF 5.2 has no pressure dependence: rows at different pressures are fitted as one tyre", stacklevel=2)
+        warnings.warn(
+            "MF 5.2 has no pressure dependence: rows at different pressures are fitted as one tyre", stacklevel=2
+        )
     vx = cols.get("vx", np.full(table.shape[0], np.nan))
     return TyreMeasurements(*(jnp.asarray(cols[c]) for c in REQUIRED_COLUMNS), jnp.asarray(vx))
 
 
-def _with(tyre: MagicFormulaTyre, names: tuple[str, ...], values: Float[Array, "k"]) -> MagicFormulaTyre:
+def _with(tyre: MagicFormulaTyre, names: tuple[str, ...], values: Float[Array, " k"]) -> MagicFormulaTyre:
     """``tyre`` with the coefficients ``names`` replaced by the entries of ``values``."""
     return eqx.tree_at(lambda t: [getattr(t, n) for n in names], tyre, [values[i] for i in range(len(names))])
 
 
-def _residuals(tyre: MagicFormulaTyre, data: TyreMeasurements, outputs: tuple[str, ...]) -> Float[Array, "m"]:
+def _residuals(tyre: MagicFormulaTyre, data: TyreMeasurements, outputs: tuple[str, ...]) -> Float[Array, " m"]:
     """Model minus measurement, forces over Fz and Mz over Fz R0 (dimensionless)."""
     model = _predict(tyre, data)
     scale = jnp.maximum(jnp.abs(data.fz), 1e-3 * tyre.fnomin)
@@ -185,21 +189,25 @@ def fit_tir(
     Args:
         data: measurements (:func:`read_tyre_csv`).
         start: initial coefficients (and all coefficients not fitted); default the shipped
-            FSAE tyre with ``FNOMIN`` set to the median measured load.
+            FSAE tyre with ``FNOMIN`` set to the median measured load. Checked like any
+            tyre (``ParameterError`` names a coefficient out of range).
         stages: what to fit in which order (default :data:`DEFAULT_STAGES`); a stage with
             fewer rows than coefficients, or only combined rows missing, is skipped.
-        rtol, atol, max_steps: Levenberg-Marquardt settings.
+        rtol, atol, max_steps: Levenberg-Marquardt settings (> 0, > 0, >= 1).
 
     Returns:
         :class:`FitReport` with the fitted tyre and, per stage, the rows used, RMS
         residuals before and after [N, Nm], steps taken and whether it converged.
     """
     check_x64()
+    for name, tol in (("rtol", rtol), ("atol", atol)):
+        check_static(name, tol, POSITIVE)
+    max_steps = check_int("max_steps", max_steps, 1, "Levenberg-Marquardt steps per stage")
     if start is None:
         from ._tir import load_fsae_tyre
 
         start = eqx.tree_at(lambda t: t.fnomin, load_fsae_tyre(), jnp.median(data.fz))
-    tyre = start
+    tyre = check_tyre(start)
     report = []
     for stage in stages:
         mask = _rows(data, stage.rows)

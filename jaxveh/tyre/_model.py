@@ -17,8 +17,10 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
+from .._core import is_concrete
 from ..params import float_field
 from ._base import AbstractTyre, TyreForces
+from ._checks import check_tyre, coefficient_ranges
 from ._magic_formula import tyre_forces
 from ._transient import relaxation_lengths
 from ._vertical import effective_rolling_radius, vertical_force
@@ -37,7 +39,8 @@ def _c(section: str, default: float, doc: str, required: bool = False):
 
 _MOD, _DIM, _VER = "MODEL", "DIMENSION", "VERTICAL"
 _KR, _AR, _CR, _FR = "LONG_SLIP_RANGE", "SLIP_ANGLE_RANGE", "INCLINATION_ANGLE_RANGE", "VERTICAL_FORCE_RANGE"
-_SC, _LO, _OV, _LA = "SCALING_COEFFICIENTS", "LONGITUDINAL_COEFFICIENTS", "OVERTURNING_COEFFICIENTS", "LATERAL_COEFFICIENTS"
+_SC, _LO = "SCALING_COEFFICIENTS", "LONGITUDINAL_COEFFICIENTS"
+_OV, _LA = "OVERTURNING_COEFFICIENTS", "LATERAL_COEFFICIENTS"
 _RO, _AL, _RL = "ROLLING_COEFFICIENTS", "ALIGNING_COEFFICIENTS", "RELAXATION_LENGTH"
 
 Scalar = Float[Array, ""]
@@ -227,22 +230,25 @@ class MagicFormulaTyre(AbstractTyre):
             )
         if self.relaxation_model not in RELAXATION_MODELS:
             raise ValueError(f"relaxation_model must be one of {RELAXATION_MODELS}, got {self.relaxation_model!r}")
+        ranges = coefficient_ranges(self.relaxation_model)
+        if all(is_concrete(getattr(self, n)) for n in ranges):
+            check_tyre(self)
 
     def forces(self, fz: ArrayLike, kappa: ArrayLike, alpha: ArrayLike, gamma: ArrayLike, vx: ArrayLike) -> TyreForces:
         """:func:`jaxveh.tyre.tyre_forces` of this tyre."""
-        return tyre_forces(self, fz, kappa, alpha, gamma, vx)
+        return tyre_forces(check_tyre(self), fz, kappa, alpha, gamma, vx)
 
     def relaxation_lengths(self, fz: ArrayLike, gamma: ArrayLike) -> tuple[Scalar, Scalar]:
         """:func:`jaxveh.tyre.relaxation_lengths` of this tyre [m]."""
-        return relaxation_lengths(self, fz, gamma)
+        return relaxation_lengths(check_tyre(self), fz, gamma)
 
     def vertical_force(self, deflection: ArrayLike, deflection_rate: ArrayLike) -> Scalar:
         """:func:`jaxveh.tyre.vertical_force` of this tyre [N]."""
-        return vertical_force(self, deflection, deflection_rate)
+        return vertical_force(check_tyre(self), deflection, deflection_rate)
 
     def effective_rolling_radius(self, fz: ArrayLike) -> Scalar:
         """:func:`jaxveh.tyre.effective_rolling_radius` of this tyre [m]."""
-        return effective_rolling_radius(self, fz)
+        return effective_rolling_radius(check_tyre(self), fz)
 
 
 def coefficient_fields() -> tuple[dataclasses.Field, ...]:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._config import check_x64
+from .._core import check_x64
 from ..params import ParameterError
 from ._model import SUPPORTED_FITTYP, MagicFormulaTyre, coefficient_fields
 
@@ -134,7 +134,10 @@ def parse_tir(text: str, source: str = "<tir>") -> MagicFormulaTyre:
     _check_ranges(values, source)
     mf52 = values.get("ptx1", 0.0) != 0.0 and values.get("pty1", 0.0) != 0.0
     model = "mf52" if mf52 and not has_relaxation_section else "constant"
-    return MagicFormulaTyre(**values, fittyp=fittyp, relaxation_model=model, extras=tuple(extras))
+    try:
+        return MagicFormulaTyre(**values, fittyp=fittyp, relaxation_model=model, extras=tuple(extras))
+    except ParameterError as e:
+        raise TirError(f"{source}: {e}") from None
 
 
 def _check_ranges(values: dict[str, float], source: str) -> None:

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
+from ..params import Range, check
 from ._magic_formula import LIFTOFF_FRACTION
 
 if TYPE_CHECKING:
@@ -34,7 +35,9 @@ def relaxation_lengths(tyre: "MagicFormulaTyre", fz: ArrayLike, gamma: ArrayLike
         sigma_kappa = Fz (PTX1 + PTX2 dfz) exp(-PTX3 dfz) (R0 / Fz0) LSGKP
         sigma_alpha = PTY1 sin(2 atan(Fz / (PTY2 Fz0))) (1 - PKY3 |gamma|) R0 LFZO LSGAL
 
-    with the load floored at ``LIFTOFF_FRACTION * Fz0`` so the lengths stay positive.
+    with the load floored at ``LIFTOFF_FRACTION * Fz0``. The lengths must come out > 0 (the
+    coefficients are checked, but ``PTX2`` or ``PKY3 |gamma|`` can still drive them to zero at
+    some loads or cambers): ``ParameterError``, or ``eqx.error_if`` when traced.
     """
     t = tyre
     if t.relaxation_model == "constant":
@@ -46,7 +49,12 @@ def relaxation_lengths(tyre: "MagicFormulaTyre", fz: ArrayLike, gamma: ArrayLike
     r0 = t.unloaded_radius
     sk = fz * (t.ptx1 + t.ptx2 * dfz) * jnp.exp(-t.ptx3 * dfz) * (r0 / fz0) * t.lsgkp
     sa = t.pty1 * jnp.sin(2.0 * jnp.arctan(fz / (t.pty2 * fz0))) * (1.0 - t.pky3 * jnp.abs(gamma * t.lgay))
-    return sk, sa * r0 * t.lfzo * t.lsgal
+    sa = sa * r0 * t.lfzo * t.lsgal
+    return check("sigma_kappa", sk, _LENGTH_KAPPA), check("sigma_alpha", sa, _LENGTH_ALPHA)
+
+
+_LENGTH_KAPPA = Range(0.0, low_open=True, what="MF 5.2 longitudinal relaxation length at this load, m")
+_LENGTH_ALPHA = Range(0.0, low_open=True, what="MF 5.2 lateral relaxation length at this load and camber, m")
 
 
 def transient_slip_rhs(
@@ -84,7 +92,11 @@ def transient_slips(
 
 
 def low_speed_denominator(vx: ArrayLike, vxlow: ArrayLike) -> Scalar:
-    """``|vx|`` above ``vxlow``; below it the C1 blend ``vxlow/2 + vx**2/(2 vxlow)`` [m/s]."""
+    """``|vx|`` above ``vxlow``; below it the C1 blend ``vxlow/2 + vx**2/(2 vxlow)`` [m/s].
+
+    ``vxlow`` must be > 0 (``ParameterError``; traced: ``eqx.error_if``).
+    """
+    vxlow = check("vxlow", vxlow, Range(0.0, low_open=True, what="low-speed threshold VXLOW, m/s"))
     vx = jnp.asarray(vx, dtype=jnp.float64)
     speed = jnp.abs(vx)
     return jnp.where(speed >= vxlow, speed, 0.5 * vxlow + vx**2 / (2.0 * vxlow))

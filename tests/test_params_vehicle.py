@@ -1,7 +1,8 @@
-"""Vehicle data files: SI conversion, validation errors, pytree behaviour."""
+"""Vehicle parameters: data files (SI conversion, validation errors), checks on construction,
+derived quantities that follow their base fields, pytree behaviour."""
 
+import dataclasses
 import math
-import tomllib
 from importlib import resources
 
 import equinox as eqx
@@ -9,9 +10,14 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import tomllib
 
 from jaxveh.params import (
+    CornerHardPoints,
     ParameterError,
+    RigidBodyData,
+    TyreData,
+    UnsprungData,
     analytic_vehicle_from_dict,
     hard_points_vehicle_frame,
     load_analytic_vehicle,
@@ -30,7 +36,9 @@ def test_appendix_a_in_si_units():
     v = load_analytic_vehicle()
     assert float(v.kF) == pytest.approx(205.0 / DEG)
     assert float(v.kC) == pytest.approx(380.0 / DEG)
-    assert float(v.a) == pytest.approx(0.843)
+    # a and hG are derived from the masses (unsprung masses at the axles); Table A.1 rounds them.
+    assert float(v.a) == pytest.approx(0.843, rel=1e-3)
+    assert float(v.hG) == pytest.approx(0.295, abs=2.5e-3)
     assert float(v.l) == pytest.approx(1.555)
     assert float(v.m) == 290.0
     assert v.kF.dtype == jnp.float64
@@ -52,7 +60,12 @@ def test_appendix_b_in_si_units():
         ("mass", "ms", -1.0, r"\[mass\]\.ms \(sprung mass\) = -1 kg is out of range: allowed > 0 kg"),
         ("suspension", "kF", 0.0, r"\[suspension\]\.kF .* allowed > 0 Nm/deg"),
         ("chassis", "kC", -5.0, r"\[chassis\]\.kC"),
-        ("geometry", "a", 2000.0, r"\[geometry\]\.l = 1.555 m is inconsistent with a \+ b \(c.g. must lie inside the wheelbase\) = 2.712 m"),
+        (
+            "geometry",
+            "a",
+            2000.0,
+            r"\[geometry\]\.l = 1.555 m is inconsistent with a \+ b \(c.g. must lie inside the wheelbase\) = 2.712 m",
+        ),
         ("geometry", "b", -10.0, r"\[geometry\]\.b"),
         ("mass", "m", 300.0, r"\[mass\]\.m = 300 kg is inconsistent with ms \+ muF \+ muR = 290 kg"),
         ("suspension", "cF", "soft", r"must be a number"),
@@ -137,3 +150,71 @@ def test_data_documentation_is_current():
 
     doc = Path(__file__).resolve().parents[1] / "docs" / "data.md"
     assert doc.read_text() == render(), "docs/data.md is stale: run python -m jaxveh.params.docs"
+
+
+def test_derived_quantities_follow_their_base_fields():
+    """m, l, a, b, hG are properties: a change of a base field (eqx.tree_at bypasses
+    __init__) moves them, so nothing stored goes stale."""
+    v = load_analytic_vehicle()
+    heavier = eqx.tree_at(lambda x: x.ms, v, v.ms + 50.0)
+    assert float(heavier.m) == pytest.approx(float(v.m) + 50.0, rel=1e-15)
+    # The sprung mass sits behind the vehicle c.g. (as = 0.830 m < a = 0.842 m): more of it
+    # moves the c.g. rearwards; its c.g. is higher than the unsprung ones: hG rises.
+    assert float(heavier.a) < float(v.a) and float(heavier.hG) > float(v.hG)
+    longer = eqx.tree_at(lambda x: x.bs, v, v.bs + 0.1)
+    assert float(longer.l) == pytest.approx(float(v.l) + 0.1, rel=1e-15)
+    assert float(longer.a + longer.b) == pytest.approx(float(longer.l), rel=1e-15)
+    # Closed forms, and the gradients of the derived values with respect to their bases.
+    ms, muf, mur = float(v.ms), float(v.muF), float(v.muR)
+    assert float(v.a) == pytest.approx((ms * float(v.as_) + mur * float(v.l)) / (ms + muf + mur), rel=1e-14)
+    grads = eqx.filter_grad(lambda x: x.m + x.l)(v)
+    assert float(grads.ms) == float(grads.muF) == float(grads.muR) == 1.0
+    assert float(grads.as_) == float(grads.bs) == 1.0
+    for name in ("m", "a", "b", "l", "hG"):
+        assert not hasattr(grads, name) or isinstance(getattr(type(v), name), property)
+
+
+def test_rigid_load_transfers_add_up_to_the_total():
+    """With hG derived from the masses, the axle transfers of (3.4) add up to m hG ay / t
+    for any masses and heights (Table A.1's rounded hG would miss by 0.2 %)."""
+    from jaxveh.analytic import load_transfer_rigid
+
+    v = load_analytic_vehicle()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        scale = rng.uniform(0.7, 1.3, 5)
+        w = eqx.tree_at(lambda x: (x.ms, x.muF, x.muR, x.hsF, x.huR),
+                        v, tuple(jnp.asarray(s) * f for s, f in zip((v.ms, v.muF, v.muR, v.hsF, v.huR), scale)))
+        front, rear = load_transfer_rigid(w, 1.0)
+        assert float(front + rear) == pytest.approx(float(w.m * w.hG / w.t), rel=1e-13)
+
+
+def test_file_checks_derived_values():
+    table = _table("appendix_a.toml")
+    table["geometry"]["hG"] = 300.0
+    with pytest.raises(ParameterError, match=r"\[geometry\]\.hG = 0\.3 m is inconsistent with .* = 0\.294317 m"):
+        analytic_vehicle_from_dict(table, "bad.toml")
+    table = _table("appendix_a.toml")
+    table["geometry"]["a"], table["geometry"]["b"] = 853.0, 702.0
+    with pytest.raises(ParameterError, match=r"\[geometry\]\.a = 0\.853 m is inconsistent with \(ms as \+ muR l\)/m"):
+        analytic_vehicle_from_dict(table, "bad.toml")
+
+
+@pytest.mark.parametrize(
+    "build, match",
+    [
+        (lambda d: RigidBodyData(-1.0, d.sprung.inertia), r"RigidBodyData\.mass must lie in \(0, inf\) \(mass, kg\)"),
+        (lambda d: RigidBodyData(1.0, -np.eye(3)), r"RigidBodyData\.inertia eigenvalues must lie in \(0, inf\)"),
+        (lambda d: RigidBodyData(1.0, np.eye(2)), r"RigidBodyData\.inertia must have shape \(3, 3\)"),
+        (lambda d: TyreData(1.5e5, 50.0, 0.3, -0.3), r"TyreData\.sigma_alpha must lie in \(0, inf\)"),
+        (lambda d: TyreData(1.5e5, -50.0, 0.3, 0.3), r"TyreData\.cz must lie in \[0, inf\)"),
+        (lambda d: UnsprungData(d.unsprung_front.body, 0.0), r"UnsprungData\.wheel_spin_inertia must lie in"),
+        (lambda d: CornerHardPoints(np.asarray(d.hard_points_front.points) * np.array([1.0, -1.0, 1.0])),
+         r"CornerHardPoints\.points y must lie in \(0, inf\) \(left corner, m\)"),
+        (lambda d: dataclasses.replace(d, track_rear=0.0), r"VehicleData\.track_rear must lie in \(0, inf\)"),
+        (lambda d: dataclasses.replace(d, toe_front=0.5), r"VehicleData\.toe_front must lie in \[-0\.174533, 0\.1745"),
+    ],
+)
+def test_appendix_b_modules_check_on_construction(build, match):
+    with pytest.raises(ParameterError, match=match):
+        build(load_vehicle_data())

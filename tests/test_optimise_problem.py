@@ -1,18 +1,19 @@
-"""optimise: variable selection, bounds, gradients, and the two chapter-3 worked examples."""
+"""optimise: variable selection, bounds, gradients, input checks and the two chapter-3 worked examples."""
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+import optax
 import pytest
 import scipy.optimize
+from helpers import central_difference
 
 import jaxveh.analytic as analytic
 from jaxveh.analytic._maps import minimum_stiffness
-from jaxveh.params import load_analytic_vehicle
-from optimise import Problem, Variable, get_leaf, set_leaves
+from jaxveh.params import ParameterError, load_analytic_vehicle
+from optimise import Problem, Variable, get_leaf, set_leaves, solve
 from optimise.examples import minimum_chassis_stiffness, roll_distribution_for_understeer
-
-from helpers import central_difference
 
 
 @pytest.fixture(scope="module")
@@ -65,5 +66,45 @@ def test_example_b_hits_target(vehicle):
     out = roll_distribution_for_understeer(target_ku, vehicle, mu=1.0)
     assert out["ku_deg_per_g"] == pytest.approx(target_ku, abs=1e-5)
     flex = analytic.with_distribution(vehicle, mu=1.0)
-    ku = lambda lam: float(analytic.understeer_gradient(analytic.with_distribution(flex, lam=lam)) * analytic.RAD_PER_MS2_TO_DEG_PER_G) - target_ku
+    def ku(lam):
+        v = analytic.with_distribution(flex, lam=lam)
+        return float(analytic.understeer_gradient(v) * analytic.RAD_PER_MS2_TO_DEG_PER_G) - target_ku
+
     assert out["lam"] == pytest.approx(scipy.optimize.brentq(ku, 0.05, 0.95), abs=1e-4)
+
+
+@pytest.mark.parametrize(
+    "variables, match",
+    [
+        ((Variable("m", 100.0, 400.0),), r"parameter path 'm': AnalyticVehicle\.m is derived from other fields"),
+        ((Variable("kC", 1.0, float("inf")),), r"variable 'kC': bounds must be finite"),
+        ((Variable("kC", 1.0, 10.0), Variable("kC", 2.0, 20.0)), r"design variable names must be unique"),
+        ((Variable("kC", -1.0, 10.0, log=True),), r"variable 'kC': log scale needs lower > 0"),
+        ((), r"Problem needs at least one design variable"),
+    ],
+)
+def test_problem_definition_errors(vehicle, variables, match):
+    with pytest.raises(ParameterError, match=match):
+        Problem(vehicle, variables, lambda v: v.kC)
+
+
+def test_solve_settings_and_initial_values(vehicle):
+    problem = Problem(vehicle, (Variable("kC", 10.0, 1e5, log=True),), lambda v: analytic.chi(v))
+    with pytest.raises(ParameterError, match=r"initial values missing for design variable\(s\) \['kC'\]"):
+        solve(problem, {})
+    for settings, match in (
+        ({"inner_steps": 0}, r"inner_steps must be a Python int >= 1"),
+        ({"rho": 0.0}, r"rho must lie in \(0, inf\)"),
+        ({"rho_growth": 0.5}, r"rho_growth must lie in \[1, inf\)"),
+        ({"constraint_tol": -1.0}, r"constraint_tol must lie in \(0, inf\)"),
+    ):
+        with pytest.raises(ParameterError, match=match):
+            solve(problem, {"kC": 1000.0}, **settings)
+
+
+def test_optimiser_leaving_the_physical_range_raises_named_error(vehicle):
+    """Bounds that admit a negative roll stiffness: the traced check stops the solve with the
+    field's name instead of letting NaN or nonsense through."""
+    problem = Problem(vehicle, (Variable("kF", -5000.0, 20000.0),), lambda v: analytic.roll_stiffness_proportion(v))
+    with pytest.raises(eqx.EquinoxRuntimeError, match=r"AnalyticVehicle\.kF must lie in \[0, inf\)"):
+        solve(problem, {"kF": 1000.0}, optax.sgd(1.0), inner_steps=50, outer_steps=1)
