@@ -175,7 +175,7 @@ def test_gradient_of_simulation_wrt_mass_and_hard_point(car, drop_run):
 
 def test_unreachable_travel_raises_naming_constraint_and_gap(car):
     system, params = car
-    with pytest.raises(mb.AssemblyError, match=r"bump 400 mm.*constraint \w+\[length\] misses by \d"):
+    with pytest.raises(mb.AssemblyError, match=r"bump 400 mm.*constraint \w+\[length\] residual \(gap\) \d"):
         ex.quarter_car_kinematics(system, params, 0.4, 0.0)
 
 

@@ -25,6 +25,24 @@ from ._errors import (
     RedundantConstraintError as RedundantConstraintError,
     SingularMassMatrixError as SingularMassMatrixError,
 )
+from ._forces import (
+    AbstractForceElement as AbstractForceElement,
+    Bushing as Bushing,
+    ElementForces as ElementForces,
+    FirstOrderLag as FirstOrderLag,
+    Kinematics as Kinematics,
+    SpringDamper as SpringDamper,
+    TorsionSpring as TorsionSpring,
+    aux_names as aux_names,
+    generalised_forces as generalised_forces,
+    kinematics as kinematics,
+    zero_forces as zero_forces,
+)
+from ._inputs import (
+    AbstractInputs as AbstractInputs,
+    StateInputs as StateInputs,
+    TimeInputs as TimeInputs,
+)
 from ._kinematics import (
     body_poses as body_poses,
     body_rotation as body_rotation,
@@ -46,6 +64,7 @@ from ._linear import (
     Linearisation as Linearisation,
     chart as chart,
     linearise as linearise,
+    minimal_rates as minimal_rates,
 )
 from ._projection import (
     Dynamics as Dynamics,
@@ -53,6 +72,7 @@ from ._projection import (
     check_mass_matrix as check_mass_matrix,
     check_rank as check_rank,
     dynamics as dynamics,
+    input_state as input_state,
     input_values as input_values,
     multipliers as multipliers,
     projection as projection,
@@ -72,6 +92,7 @@ from ._simulate import (
     solve_assembly as solve_assembly,
     ProjectedSolver as ProjectedSolver,
     Simulation as Simulation,
+    State as State,
     project_coordinates as project_coordinates,
     assemble as assemble,
     independent_velocities as independent_velocities,

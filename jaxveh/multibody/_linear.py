@@ -25,7 +25,8 @@ CHART_ITERATIONS = 4
 
 
 class Linearisation(eqx.Module):
-    """``x_dot = A x + B w`` in minimal coordinates ``x = [s, z]`` (n = 2 ndof) about a state.
+    """``x_dot = A x + B w`` in minimal coordinates ``x = [s, z, aux]`` about a state
+    (``n = 2 ndof + n_aux``).
 
     ``A`` (n x n); ``B`` (n x nw) for the external-force arguments ``w`` (empty when none);
     ``tangent`` = ``dq/ds`` (nq x ndof) maps minimal coordinates to ``q``.
@@ -36,15 +37,26 @@ class Linearisation(eqx.Module):
     tangent: Float[Array, "nq ndof"]
 
 
-def chart(system: System, params: SystemParams, q0, t=0.0, inputs: Inputs | None = None):
+def chart(system: System, params: SystemParams, q0, t=0.0, inputs: Inputs | None = None, aux=None):
     """``q(s)``: the constraint manifold near ``q0`` in minimal coordinates (see module)."""
     t = jnp.asarray(t, q0.dtype)
-    basis = velocity_matrix(system, params, q0) @ projection(system, params, q0, t, inputs).R
+    basis = velocity_matrix(system, params, q0) @ projection(system, params, q0, t, inputs, 0.0, aux).R
 
     def q_of(s):
-        return project_coordinates(system, params, q0 + basis @ s, t, inputs, CHART_ITERATIONS)
+        return project_coordinates(system, params, q0 + basis @ s, t, inputs, CHART_ITERATIONS, aux)
 
     return q_of
+
+
+def minimal_rates(system, params, q_of, s, z, aux, w, t=0.0, inputs=None, external=None, elements=(), with_args=False):
+    """``[s_dot, z_dot, aux_dot]`` at minimal coordinates ``s`` of the chart ``q_of``."""
+    qs = q_of(s)
+    dyn = dynamics(system, params, qs, z, t, inputs, external, w if with_args else None, 0.0, elements, aux)
+    jac = jax.jacfwd(q_of)(s)
+    # full column rank; normal equations, not an SVD (whose derivative is undefined at the
+    # repeated singular values of symmetric structures)
+    s_dot = jnp.linalg.solve(jac.T @ jac, jac.T @ dyn.q_dot)
+    return jnp.concatenate([s_dot, dyn.z_dot, dyn.aux_dot])
 
 
 def linearise(
@@ -56,27 +68,29 @@ def linearise(
     inputs: Inputs | None = None,
     external=None,
     args=None,
+    elements: tuple = (),
+    aux=None,
 ) -> Linearisation:
-    """Exact linearisation of eq. (5.61) at ``(q, z, t)`` (``q`` assembled).
+    """Exact linearisation of eq. (5.61) at ``(q, z, aux, t)`` (``q`` assembled).
 
     ``external(q, v, t, args)`` as in :func:`dynamics`; ``B`` is the Jacobian with respect
     to ``args`` (a flat array of force inputs, e.g. a steering torque), empty when ``args``
-    is None. Rheonomic inputs are held at their time history.
+    is None. ``elements`` / ``aux``: force elements and their states. Rheonomic inputs
+    follow their law (open-loop: their time history at ``t``).
     """
     q, z = jnp.asarray(q, jnp.float64), jnp.asarray(z, jnp.float64)
     params = checked_params(system, params)
     t = jnp.asarray(t, q.dtype)
-    q_of = chart(system, params, q, t, inputs)
+    aux = jnp.zeros((0,), q.dtype) if aux is None else jnp.asarray(aux, q.dtype)
+    q_of = chart(system, params, q, t, inputs, aux)
     w0 = jnp.zeros((0,), q.dtype) if args is None else jnp.asarray(args, q.dtype)
 
-    def rates(s, zz, w):
-        qs = q_of(s)
-        dyn = dynamics(system, params, qs, zz, t, inputs, external, None if args is None else w)
-        jac = jax.jacfwd(q_of)(s)
-        s_dot = jnp.linalg.solve(jac.T @ jac, jac.T @ dyn.q_dot)  # full column rank; no SVD (its
-        # derivative is undefined at the repeated singular values of symmetric structures)
-        return jnp.concatenate([s_dot, dyn.z_dot])
+    def rates(x, w):
+        n = system.n_dof
+        return minimal_rates(
+            system, params, q_of, x[:n], x[n : 2 * n], x[2 * n :], w, t, inputs, external, elements, args is not None
+        )
 
-    s0 = jnp.zeros((system.n_dof,), q.dtype)
-    a_s, a_z, b = jax.jacfwd(rates, argnums=(0, 1, 2))(s0, z, w0)
-    return Linearisation(A=jnp.concatenate([a_s, a_z], axis=1), B=b, tangent=jax.jacfwd(q_of)(s0))
+    x0 = jnp.concatenate([jnp.zeros((system.n_dof,), q.dtype), z, aux])
+    a, b = jax.jacfwd(rates, argnums=(0, 1))(x0, w0)
+    return Linearisation(A=a, B=b, tangent=jax.jacfwd(q_of)(jnp.zeros((system.n_dof,), q.dtype)))

@@ -19,28 +19,44 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from ._dynamics import internal_forces, mass_matrix
+from ._forces import Kinematics, element_forces, generalised_forces, kinematics
+from ._inputs import AbstractInputs, as_inputs
 from ._errors import RedundantConstraintError, SingularMassMatrixError
 from ._kinematics import body_poses, body_velocities, constraint_rates, constraints, qdot_from_velocities
 from ._system import System, SystemParams
 
-Inputs = Callable[[Float[Array, ""]], Float[Array, " ni"]]
+Inputs = Callable[[Float[Array, ""]], Float[Array, " ni"]] | AbstractInputs
 External = Callable[..., Float[Array, " nv"]]
 
 
-def input_values(system: System, inputs: Inputs | None, t, dtype=jnp.float64):
-    """Rheonomic input values ``u(t)``; an empty vector for a system without inputs."""
+def _empty(dtype):
+    return jnp.zeros((0,), dtype)
+
+
+def input_state(system: System, inputs, t, q, aux=None):
+    """``(u, u_dot)``: rheonomic input values and rates at ``(t, q, aux)`` (empty vectors for
+    a system without inputs)."""
     if system.n_inputs == 0:
-        return jnp.zeros((0,), dtype)
-    if inputs is None:
-        raise ValueError(f"system has inputs {system.input_names}; pass an `inputs(t)` function")
-    return jnp.asarray(inputs(t), dtype=dtype)
+        return _empty(q.dtype), _empty(q.dtype)
+    law = as_inputs(inputs)
+    if law is None:
+        raise ValueError(f"system has inputs {system.input_names}; pass an `inputs(t)` function or an input law")
+    aux = _empty(q.dtype) if aux is None else aux
+    u, u_dot = law.value(t, q, aux), law.rate(t, q, aux)
+    if u.shape != (system.n_inputs,) or u_dot.shape != (system.n_inputs,):
+        raise ValueError(f"inputs must give {system.n_inputs} values {system.input_names}, got shape {u.shape}")
+    return u, u_dot
 
 
-def _phi_of(system, params, inputs):
-    def phi(q, t):
-        return constraints(system, params, q, input_values(system, inputs, t, q.dtype))
-
-    return phi
+def input_values(system: System, inputs, t, dtype=jnp.float64, q=None, aux=None):
+    """Rheonomic input values ``u``; an empty vector for a system without inputs."""
+    if system.n_inputs == 0:
+        return _empty(dtype)
+    law = as_inputs(inputs)
+    if law is None:
+        raise ValueError(f"system has inputs {system.input_names}; pass an `inputs(t)` function or an input law")
+    q = _empty(dtype) if q is None else q
+    return jnp.asarray(law.value(t, q, _empty(dtype) if aux is None else aux), dtype=dtype)
 
 
 class Projection(eqx.Module):
@@ -60,16 +76,14 @@ class Projection(eqx.Module):
     lu: tuple
 
 
-def _jacobians(system, params, q, t, inputs):
-    """``Phi``, ``Phi_t``, ``T`` and ``Phi_q B T`` at ``(q, t)``.
+def _jacobians(system, params, q, u, u_dot):
+    """``Phi``, ``Phi_t = Phi_u u_dot``, ``T`` and ``Phi_q B T`` at ``q`` and inputs ``u``.
 
     ``Phi_q B T`` is the Jacobian of the explicit constraint rates (linear in the body
     velocities) composed with the recursion, so only one forward pass with ``n_y`` tangents
     through cheap linear maps is needed; the rotation matrices are not differentiated.
     """
-    phi_fn = _phi_of(system, params, inputs)
-    phi, phi_t = jax.jvp(lambda tt: phi_fn(q, tt), (t,), (jnp.ones_like(t),))
-    u = input_values(system, inputs, t, q.dtype)
+    phi, phi_t = jax.jvp(lambda uu: constraints(system, params, q, uu), (u,), (u_dot,))
     poses = body_poses(system, params, q)
 
     def linear(y):
@@ -100,7 +114,7 @@ def solve_s(system: System, lu, rhs):
 
 
 def projection(
-    system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, kappa=0.0
+    system: System, params: SystemParams, q, t=0.0, inputs: Inputs | None = None, kappa=0.0, aux=None
 ) -> Projection:
     """Constraint residuals, ``T``, ``Phi_q B T`` and the projection ``R``, ``S b`` (eq. 5.54).
 
@@ -109,8 +123,12 @@ def projection(
     columns is LU-factorised (``m x m`` instead of ``n_y x n_y``) and reused for ``R``,
     ``S b``, ``S c`` and the multipliers. ``R`` and ``S`` are exactly those of eq. (5.55).
     """
-    t = jnp.asarray(t, q.dtype)
-    phi, phi_t, t_mat, phi_y = _jacobians(system, params, q, t, inputs)
+    u, u_dot = input_state(system, inputs, jnp.asarray(t, q.dtype), q, aux)
+    return _projection(system, params, q, u, u_dot, kappa)
+
+
+def _projection(system, params, q, u, u_dot, kappa) -> Projection:
+    phi, phi_t, t_mat, phi_y = _jacobians(system, params, q, u, u_dot)
     phi_d = phi_y[:, jnp.asarray(_dependent(system), dtype=int)]
     phi_i = phi_y[:, jnp.asarray(system.independent, dtype=int)]
     lu = jax.scipy.linalg.lu_factor(phi_d)
@@ -127,15 +145,13 @@ def projection(
     return Projection(phi=phi, phi_y=phi_y, T=t_mat, R=r, Sb=_scatter(system, sol[:, 0], zeros), lu=lu)
 
 
-def _velocity_constraint(system, params, inputs, y, kappa):
-    """``h(q, t) = Phi_q B T y + Phi_t + kappa Phi`` with ``y`` held fixed."""
-    phi_fn = _phi_of(system, params, inputs)
+def _velocity_constraint(system, params, y, kappa):
+    """``h(q, u, w) = Phi_q B T y + Phi_u w + kappa Phi`` with ``y`` held fixed (``w`` the input rates)."""
 
-    def h(q, t):
-        u = input_values(system, inputs, t, q.dtype)
+    def h(q, u, w):
         poses = body_poses(system, params, q)
         vs = body_velocities(system, params, q, y, poses)
-        phi, phi_t = jax.jvp(lambda tt: phi_fn(q, tt), (t,), (jnp.ones_like(t),))
+        phi, phi_t = jax.jvp(lambda uu: constraints(system, params, q, uu), (u,), (w,))
         return constraint_rates(system, params, poses, vs, u) + phi_t + kappa * phi
 
     return h
@@ -148,7 +164,9 @@ class Dynamics(eqx.Module):
     accelerations, ``mass_matrix`` the reduced ``R^T T^T M T R``, ``internal_forces`` the
     reduced velocity/elastic/damping forces ``R^T T^T (Q_v + Q_e - M (T_dot y + T S c))``,
     ``external_forces`` the reduced gravity + applied forces, ``y_dot``, ``v_dot``, ``Sc``,
-    ``multipliers`` (see :func:`multipliers`). Under ``jit`` whatever the caller does not use
+    ``multipliers`` (see :func:`multipliers`), ``aux_dot`` (auxiliary-state derivatives of
+    the force elements), ``u`` / ``u_dot`` (inputs and rates) and ``kinematics`` (the
+    :class:`Kinematics` the elements saw; None without elements). Under ``jit`` whatever the caller does not use
     is removed by dead-code elimination.
     """
 
@@ -164,6 +182,10 @@ class Dynamics(eqx.Module):
     internal_forces: Float[Array, " ndof"]
     external_forces: Float[Array, " ndof"]
     multipliers: Float[Array, " m"]
+    aux_dot: Float[Array, " na"]
+    u: Float[Array, " ni"]
+    u_dot: Float[Array, " ni"]
+    kinematics: Kinematics | None
 
 
 def dynamics(
@@ -176,28 +198,45 @@ def dynamics(
     external: External | None = None,
     args=None,
     kappa=0.0,
+    elements: tuple = (),
+    aux=None,
 ) -> Dynamics:
-    """Reduced equations of motion (eq. 5.61) at ``(q, z, t)``.
+    """Reduced equations of motion (eq. 5.61) at ``(q, z, aux, t)``.
 
-    ``external(q, v, t, args)`` returns applied generalised forces in ``v`` coordinates (use
-    :func:`point_force` / :func:`body_torque`); gravity is built in (``params.gravity``).
+    ``elements``: force elements (:class:`AbstractForceElement`), evaluated on one shared
+    :class:`Kinematics`; ``aux`` their auxiliary states. ``external(q, v, t, args)`` returns
+    further applied generalised forces in ``v`` coordinates (use :func:`point_force` /
+    :func:`body_torque`); gravity is built in (``params.gravity``). ``inputs``: a function
+    of time or an input law (:mod:`._inputs`).
     """
     t = jnp.asarray(t, q.dtype)
-    proj = projection(system, params, q, t, inputs, kappa)
+    aux = _empty(q.dtype) if aux is None else aux
+    law = as_inputs(inputs)
+    u, u_dot = input_state(system, law, t, q, aux)
+    proj = _projection(system, params, q, u, u_dot, kappa)
     y = proj.R @ z + proj.Sb
     poses = body_poses(system, params, q)
     vs = body_velocities(system, params, q, y, poses)
     v = jnp.concatenate(vs)
     q_dot = qdot_from_velocities(system, params, q, y, vs, poses)
-    h = _velocity_constraint(system, params, inputs, y, kappa)
-    c = -jax.jvp(h, (q, t), (q_dot, jnp.ones_like(t)))[1]
+    q_int, q_grav = internal_forces(system, params, q, v)
+    q_ext = q_grav if external is None else q_grav + external(q, v, t, args)
+    kin, aux_dot = None, _empty(q.dtype)
+    if elements:
+        kin = kinematics(system, params, q, vs, poses, u, u_dot, t)
+        forces, torques, aux_dot = element_forces(system, params, elements, kin, aux)
+        q_ext = q_ext + generalised_forces(system, params, q, poses, forces, torques)
+    if system.n_inputs:
+        u_ddot = jax.jvp(lambda tt, qq, aa: law.rate(tt, qq, aa), (t, q, aux), (jnp.ones_like(t), q_dot, aux_dot))[1]
+    else:
+        u_ddot = u_dot
+    h = _velocity_constraint(system, params, y, kappa)
+    c = -jax.jvp(h, (q, u, u_dot), (q_dot, u_dot, u_ddot))[1]
     sc = solve_s(system, proj.lu, c)
     t_dot_y = jax.jvp(lambda qq: jnp.concatenate(body_velocities(system, params, qq, y)), (q,), (q_dot,))[1]
     a0 = proj.T @ sc + t_dot_y  # body accelerations at z_dot = 0
     tr = proj.T @ proj.R
     m_full = mass_matrix(system, params, q)
-    q_int, q_grav = internal_forces(system, params, q, v)
-    q_ext = q_grav if external is None else q_grav + external(q, v, t, args)
     m_red = tr.T @ m_full @ tr
     f_int = tr.T @ (q_int - m_full @ a0)
     f_ext = tr.T @ q_ext
@@ -225,6 +264,10 @@ def dynamics(
         internal_forces=f_int,
         external_forces=f_ext,
         multipliers=lam,
+        aux_dot=aux_dot,
+        u=u,
+        u_dot=u_dot,
+        kinematics=kin,
     )
 
 
@@ -245,7 +288,8 @@ def check_rank(system: System, params: SystemParams, q, t=0.0, inputs: Inputs | 
     """Raise :class:`RedundantConstraintError` naming the joints or velocities at fault when
     ``[Phi_q B T; P]`` loses rank at ``q`` (Python-level check on concrete values)."""
     q = jnp.asarray(q, jnp.float64)
-    phi_y = np.asarray(_jacobians(system, params, q, jnp.asarray(t, q.dtype), inputs)[3])
+    u, u_dot = input_state(system, inputs, jnp.asarray(t, q.dtype), q)
+    phi_y = np.asarray(_jacobians(system, params, q, u, u_dot)[3])
     names_c, names_y = system.constraint_names, system.y_names
     if phi_y.shape[0] > 0:
         u, s, _ = np.linalg.svd(phi_y)

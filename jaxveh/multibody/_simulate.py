@@ -13,9 +13,17 @@ from jaxtyping import Array, Float
 
 from ._dynamics import energy
 from ._errors import AssemblyError
-from ._projection import Inputs, _dependent, _jacobians, dynamics, input_values, projection, solve_s
+from ._projection import Inputs, _dependent, dynamics, input_values, projection, solve_s
 from .._core import is_concrete
-from ._kinematics import body_poses, body_velocities, constraints, marker_positions, qdot_from_velocities
+from ._forces import aux_names, aux_offsets
+from ._kinematics import (
+    body_poses,
+    body_velocities,
+    constraint_rates,
+    constraints,
+    marker_positions,
+    qdot_from_velocities,
+)
 from ._system import System, SystemParams, checked_params
 
 #: Default gain (1/s) of the velocity-level drift stabilisation ``Phi_dot = -kappa Phi``.
@@ -93,7 +101,7 @@ def solve_assembly(
     params = checked_params(system, params)
     t = jnp.asarray(t, q_guess.dtype)
     free = np.setdiff1d(np.arange(system.n_q), np.asarray(fixed, dtype=int))
-    u = input_values(system, inputs, t, q_guess.dtype)
+    u = input_values(system, inputs, t, q_guess.dtype, q_guess)
 
     def residual(qf):
         return constraints(system, params, q_guess.at[free].set(qf), u)
@@ -120,7 +128,7 @@ def assembly_message(system: System, result: AssemblyResult, max_rotation=MAX_BR
     if float(result.residual) > ASSEMBLY_TOL:
         name = system.constraint_names[int(result.worst)]
         return (
-            f"cannot assemble: constraint {name} misses by {float(result.residual):.3e} (m or rad; "
+            f"cannot assemble: constraint {name} residual (gap) {float(result.residual):.3e} m or rad ("
             f"tolerance {ASSEMBLY_TOL:g}); the configuration cannot be reached: check the geometry, "
             "link lengths, the imposed motion and the initial guess"
         )
@@ -170,12 +178,22 @@ def assemble(
 INITIAL_RESIDUAL_TOL = 1e-8
 
 
-def _check_assembled(system, params, q0, t0, inputs):
+class State(eqx.Module):
+    """State of the ODE: coordinates ``q``, independent velocities ``z`` and the force
+    elements' auxiliary states ``aux`` (empty when there are none)."""
+
+    q: Float[Array, " nq"]
+    z: Float[Array, " ndof"]
+    aux: Float[Array, " na"]
+
+
+def _check_assembled(system, params, q0, t0, inputs, aux0):
     """Raise (concrete values) or flag at run time (traced) an unassembled ``q0``."""
     if system.n_constraints == 0:
         return q0
-    phi = jnp.abs(constraints(system, params, q0, input_values(system, inputs, jnp.asarray(t0, q0.dtype), q0.dtype)))
-    if not isinstance(phi, jax.core.Tracer):
+    u = input_values(system, inputs, jnp.asarray(t0, q0.dtype), q0.dtype, q0, aux0)
+    phi = jnp.abs(constraints(system, params, q0, u))
+    if is_concrete(phi):
         r = np.asarray(phi)
         if not np.all(r <= INITIAL_RESIDUAL_TOL):
             k = int(np.argmax(np.where(np.isfinite(r), r, np.inf)))
@@ -194,26 +212,30 @@ def independent_velocities(system: System, y) -> Float[Array, " ndof"]:
     return jnp.asarray(y)[jnp.asarray(system.independent)]
 
 
-def joint_velocities(system: System, params: SystemParams, q, z, t=0.0, inputs=None, kappa=0.0):
+def joint_velocities(system: System, params: SystemParams, q, z, t=0.0, inputs=None, kappa=0.0, aux=None):
     """``y = R z + S b`` (eq. 5.55)."""
-    proj = projection(system, params, q, t, inputs, kappa)
+    proj = projection(system, params, q, t, inputs, kappa, aux)
     return proj.R @ z + proj.Sb
 
 
-def project_coordinates(system: System, params: SystemParams, q, t, inputs=None, iterations: int = 2):
+def project_coordinates(system: System, params: SystemParams, q, t, inputs=None, iterations: int = 2, aux=None):
     """Newton projection of ``q`` onto ``Phi(q, t) = 0`` in the dependent joint directions:
     ``q <- q + B T dy`` with ``dy = -S Phi`` (independent velocities held), i.e. Newton's
     method with the Jacobian ``Phi_q B T`` the projection already factorises. A few
-    iterations from a nearby point reach round-off."""
+    iterations from a nearby point reach round-off. Touches ``q`` only."""
     if system.n_constraints == 0:
         return q
     t = jnp.asarray(t, q.dtype)
+    dep = jnp.asarray(_dependent(system), dtype=int)
 
     def step(_, qq):
-        phi, _, _, phi_y = _jacobians(system, params, qq, t, inputs)
-        lu = jax.scipy.linalg.lu_factor(phi_y[:, jnp.asarray(_dependent(system), dtype=int)])
-        dy = solve_s(system, lu, -phi)
+        u = input_values(system, inputs, t, qq.dtype, qq, aux)
         poses = body_poses(system, params, qq)
+        phi = constraints(system, params, qq, u)
+        phi_y = jax.jacfwd(
+            lambda y: constraint_rates(system, params, poses, body_velocities(system, params, qq, y, poses), u)
+        )(jnp.zeros((system.n_y,), qq.dtype))
+        dy = solve_s(system, jax.scipy.linalg.lu_factor(phi_y[:, dep]), -phi)
         vs = body_velocities(system, params, qq, dy, poses)
         return qq + qdot_from_velocities(system, params, qq, dy, vs, poses)
 
@@ -223,10 +245,10 @@ def project_coordinates(system: System, params: SystemParams, q, t, inputs=None,
 class ProjectedSolver(diffrax.AbstractAdaptiveSolver, diffrax.AbstractWrappedSolver):
     """Wraps a Diffrax solver and projects ``q`` onto the constraint manifold after every
     step (Newton-Raphson position correction, thesis section 5.5.3, step 3 of the list in
-    section 5.6). ``z`` needs no correction: ``y = R z + S b`` is recomputed from it at the
-    corrected ``q``, so the velocity constraints hold exactly. One Newton iteration per step
-    suffices: the step starts on the manifold, the residual after a step is of the order of
-    the local error, and Newton squares it."""
+    section 5.6). ``z`` and ``aux`` need no correction: ``y = R z + S b`` is recomputed from
+    ``z`` at the corrected ``q``, so the velocity constraints hold exactly. One Newton
+    iteration per step suffices: the step starts on the manifold, the residual after a step
+    is of the order of the local error, and Newton squares it."""
 
     solver: diffrax.AbstractSolver
     system: System = eqx.field(static=True)
@@ -254,8 +276,8 @@ class ProjectedSolver(diffrax.AbstractAdaptiveSolver, diffrax.AbstractWrappedSol
             terms, t0, t1, y0, args, solver_state, made_jump
         )
         params, inputs = args[0], args[1]
-        q1 = project_coordinates(self.system, params, y1[0], t1, inputs, self.iterations)
-        y1 = (q1, y1[1])
+        q1 = project_coordinates(self.system, params, y1.q, t1, inputs, self.iterations, y1.aux)
+        y1 = State(q1, y1.z, y1.aux)
         if isinstance(dense_info, dict) and "y1" in dense_info:
             dense_info = {**dense_info, "y1": y1}
         return y1, y_error, dense_info, solver_state, result
@@ -265,31 +287,59 @@ class ProjectedSolver(diffrax.AbstractAdaptiveSolver, diffrax.AbstractWrappedSol
 
 
 class Simulation(eqx.Module):
-    """Result of :func:`simulate`: saved times (s), ``q``, ``z``, joint velocities ``y``,
-    ``residual`` (max |Phi| per saved time, m or rad), ``max_residual`` over the run,
-    ``energy`` (total mechanical energy per saved time, J, without applied forces' work),
-    and the Diffrax statistics."""
+    """Result of :func:`simulate`.
+
+    ``ts`` saved times (s); ``q``, ``z``, ``aux`` and joint velocities ``y`` there;
+    ``residual`` (max |Phi| per saved time, m or rad) and ``max_residual``; ``energy``
+    (mechanical energy per saved time, J, without the work of applied forces); ``outputs``
+    (the user's named channels, a pytree of arrays with a leading time axis; None without
+    ``outputs``); ``valid`` (False at save times after the run stopped: values there hold
+    the last state); ``stop_reason`` ("completed", the name of the event that fired, or the
+    solver's failure message with its time; "traced" under ``jit``, where ``status`` tells:
+    0 completed, 1 event, 2 solver failure); ``stop_time`` (s) and ``final`` (the state
+    there, uncorrected); and the Diffrax statistics."""
 
     ts: Float[Array, " nt"]
     q: Float[Array, "nt nq"]
     z: Float[Array, "nt ndof"]
+    aux: Float[Array, "nt na"]
     y: Float[Array, "nt ny"]
     residual: Float[Array, " nt"]
     max_residual: Float[Array, ""]
     energy: Float[Array, " nt"]
+    outputs: object
+    valid: Array
+    stop_reason: str = eqx.field(static=True)
+    stop_time: Float[Array, ""]
+    status: Array
+    final: State
     stats: dict
 
 
-def vector_field(system: System, kappa=DEFAULT_KAPPA):
-    """Diffrax-ready vector field ``f(t, (q, z), (params, inputs, external, args))``."""
+def vector_field(system: System, kappa=DEFAULT_KAPPA, elements: tuple = ()):
+    """Diffrax-ready vector field ``f(t, State, (params, inputs, external, args))``."""
 
     def f(t, state, args):
         params, inputs, external, ext_args = args
-        q, z = state
-        dyn = dynamics(system, params, q, z, t, inputs, external, ext_args, kappa)
-        return dyn.q_dot, dyn.z_dot
+        dyn = dynamics(system, params, state.q, state.z, t, inputs, external, ext_args, kappa, elements, state.aux)
+        return State(dyn.q_dot, dyn.z_dot, dyn.aux_dot)
 
     return f
+
+
+def _event(events):
+    """A Diffrax event from ``{name: cond(t, state) -> bool}`` (None for no events)."""
+    if not events:
+        return None
+    names = tuple(events)
+    conds = tuple(lambda t, y, args, fn=events[n], **kw: fn(t, y) for n in names)
+    return diffrax.Event(cond_fn=conds), names
+
+
+def _hold_after_stop(x, valid):
+    """Replace values at save times after the stop (Diffrax's inf) by the last valid one."""
+    last = jnp.maximum(jnp.sum(valid) - 1, 0)
+    return jnp.where(valid.reshape((-1,) + (1,) * (x.ndim - 1)), x, x[last])
 
 
 def simulate(
@@ -304,6 +354,10 @@ def simulate(
     inputs: Inputs | None = None,
     external=None,
     args=None,
+    elements: tuple = (),
+    aux0=None,
+    outputs=None,
+    events: dict | None = None,
     solver=None,
     rtol: float = 1e-9,
     atol: float = 1e-11,
@@ -312,57 +366,108 @@ def simulate(
     kappa=DEFAULT_KAPPA,
     adjoint=None,
     project: bool = True,
+    progress: bool = False,
     throw: bool = True,
 ) -> Simulation:
-    """Integrate eq. (5.61) from ``(q0, z0)`` with Diffrax and report the constraint residual.
+    """Integrate eq. (5.61) from ``(q0, z0, aux0)`` with Diffrax and report the residual.
 
-    ``q0`` must be assembled (see :func:`assemble`). ``solver`` defaults to ``Tsit5``,
-    adaptive steps with a PID controller at ``rtol`` / ``atol``. Drift control: the
-    velocity-level stabilisation ``Phi_dot = -kappa Phi`` inside the vector field and, with
-    ``project``, a Newton projection of ``q`` after every step (:class:`ProjectedSolver`);
-    the steps then land on ``ts`` and the saved ``q`` get the same projection (the
-    Runge-Kutta dense output does not pass through the corrected step end). ``ts`` are the save times
-    (default 101 points). The wrapper is pure: ``jax.grad`` and ``jax.vmap`` go through it.
+    ``q0`` must be assembled (see :func:`assemble`). ``elements``: force elements
+    (:class:`AbstractForceElement`) with initial auxiliary states ``aux0`` (default zeros).
+    ``inputs``: a function of time or an input law (closed-loop inputs read the state).
+    ``outputs(t, state, dyn) -> pytree`` gives named channels, evaluated at the save times
+    ``ts`` (default 101 points) on the dense output, after the position correction of the
+    saved ``q``: save times never force integrator steps. ``events``: ``{name: cond(t,
+    state) -> bool}``; the run stops when one becomes True and ``stop_reason`` names it.
+    ``solver`` defaults to ``Tsit5``, adaptive steps with a PID controller at ``rtol`` /
+    ``atol``. Drift control: the velocity-level stabilisation ``Phi_dot = -kappa Phi`` and,
+    with ``project``, a Newton projection of ``q`` after every step
+    (:class:`ProjectedSolver`). ``progress`` prints a text progress meter. With ``throw``
+    a solver failure raises (Diffrax's message says when and why); without, the result
+    says it in ``stop_reason`` and holds the last valid state. Pure: ``jax.grad`` and
+    ``jax.vmap`` go through it.
     """
     q0, z0 = jnp.asarray(q0, jnp.float64), jnp.asarray(z0, jnp.float64)
+    elements = tuple(elements)
+    n_aux = aux_offsets(elements)[-1]
+    aux0 = jnp.zeros((n_aux,)) if aux0 is None else jnp.asarray(aux0, jnp.float64)
+    if aux0.shape != (n_aux,):
+        raise ValueError(f"aux0 must hold {n_aux} auxiliary states {aux_names(elements)}, got shape {aux0.shape}")
     params = checked_params(system, params)
     ts = jnp.linspace(t0, t1, 101) if ts is None else jnp.asarray(ts, jnp.float64)
-    q0 = _check_assembled(system, params, q0, t0, inputs)
+    q0 = _check_assembled(system, params, q0, t0, inputs, aux0)
     solver = diffrax.Tsit5() if solver is None else solver
     if project and system.n_constraints:
         solver = ProjectedSolver(solver, system)
+    event = _event(events)
     sol = diffrax.diffeqsolve(
-        diffrax.ODETerm(vector_field(system, kappa)),
+        diffrax.ODETerm(vector_field(system, kappa, elements)),
         solver,
         t0=t0,
         t1=t1,
         dt0=dt0,
-        y0=(q0, z0),
+        y0=State(q0, z0, aux0),
         args=(params, inputs, external, args),
-        saveat=diffrax.SaveAt(ts=ts),
-        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol, step_ts=ts if project else None),
+        saveat=diffrax.SaveAt(ts=ts, t1=True),  # t1: where the run actually ended (events)
+        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol),
         max_steps=max_steps,
         adjoint=diffrax.RecursiveCheckpointAdjoint() if adjoint is None else adjoint,
+        event=None if event is None else event[0],
+        progress_meter=diffrax.TextProgressMeter() if progress else diffrax.NoProgressMeter(),
         throw=throw,
     )
-    qs, zs = sol.ys
+    # Diffrax saves [ts before the stop..., the stop (t1 or an event), inf...]
+    last = jnp.sum(jnp.isfinite(sol.ts)) - 1
+    end = jax.tree.map(lambda x: x[last], sol.ys)
+    saved = jax.tree.map(lambda x: x[: ts.shape[0]], sol.ys)
+    valid = sol.ts[: ts.shape[0]] == ts
+    qs, zs, auxs = (_hold_after_stop(x, valid) for x in (saved.q, saved.z, saved.aux))
     if project and system.n_constraints:
-        qs = jax.vmap(lambda t, q: project_coordinates(system, params, q, t, inputs))(sol.ts, qs)
+        qs = jax.vmap(lambda t, q, a: project_coordinates(system, params, q, t, inputs, 2, a))(ts, qs, auxs)
 
-    def per_time(t, q, z):
-        proj = projection(system, params, q, t, inputs, kappa)
-        y = proj.R @ z + proj.Sb
-        res = jnp.max(jnp.abs(proj.phi)) if system.n_constraints else jnp.zeros((), q.dtype)
-        return y, res, energy(system, params, q, y)["total"]
+    def per_time(t, q, z, aux):
+        dyn = dynamics(system, params, q, z, t, inputs, external, args, kappa, elements, aux)
+        res = jnp.max(jnp.abs(dyn.projection.phi)) if system.n_constraints else jnp.zeros((), q.dtype)
+        out = None if outputs is None else outputs(t, State(q, z, aux), dyn)
+        return dyn.y, res, energy(system, params, q, dyn.y)["total"], out
 
-    ys, res, en = jax.vmap(per_time)(sol.ts, qs, zs)
+    ys, res, en, outs = jax.vmap(per_time)(ts, qs, zs, auxs)
+    reason = _stop_reason(sol, event)
     return Simulation(
-        ts=sol.ts,
+        ts=ts,
         q=qs,
         z=zs,
+        aux=auxs,
         y=ys,
         residual=res,
         max_residual=jnp.max(res),
         energy=en,
+        outputs=outs,
+        valid=valid,
+        stop_reason=reason,
+        stop_time=sol.ts[last],
+        final=end,
+        status=_status(sol.result),
         stats={k: sol.stats[k] for k in ("num_steps", "num_accepted_steps", "num_rejected_steps")},
     )
+
+
+def _status(result):
+    """0 completed, 1 stopped by an event, 2 solver failure (an array, also under ``jit``)."""
+    return jnp.where(
+        result._value == diffrax.RESULTS.successful._value,
+        0,
+        jnp.where(result._value == diffrax.RESULTS.event_occurred._value, 1, 2),
+    )
+
+
+def _stop_reason(sol, event) -> str:
+    """Why the run stopped, as text (concrete values only)."""
+    if not is_concrete(sol.result._value):
+        return "traced"
+    if sol.result == diffrax.RESULTS.event_occurred and event is not None:
+        fired = [n for n, m in zip(event[1], sol.event_mask) if bool(m)]
+        return "event: " + ", ".join(fired)
+    if sol.result != diffrax.RESULTS.successful:
+        stop = float(np.nanmax(np.where(np.isfinite(sol.ts), sol.ts, np.nan)))
+        return f"solver failed at t = {stop:.6g} s: {diffrax.RESULTS[sol.result]}"
+    return "completed"
