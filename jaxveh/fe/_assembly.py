@@ -20,7 +20,10 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
+from .._core import ParameterError
 from ._beam import (
+    CircularTube,
+    RectangularTube,
     SectionProperties,
     direction_cosines,
     local_consistent_mass,
@@ -29,6 +32,7 @@ from ._beam import (
     transformation,
 )
 from ._frame import Frame
+from ._validate import check_nonnegative
 
 
 @dataclass(frozen=True)
@@ -100,12 +104,17 @@ def _element_data(frame: Frame):
     x2 = xyz[mesh.elements[:, 1]]
     orient = frame.member_orientation[mesh.element_member]
     length, rot = jax.vmap(direction_cosines)(x1, x2, orient)
-    props = [s.properties() for s in frame.sections]
+    props = [s.properties() for s in frame.sections]  # checks the section sizes
     sec_idx = np.asarray(frame.member_section)[mesh.element_member]
     sec = jax.tree.map(lambda *v: jnp.stack(v)[sec_idx], *props)
     mat_idx = np.asarray(frame.member_material)[mesh.element_member]
-    mat = jax.tree.map(lambda *v: jnp.stack(v)[mat_idx], *frame.materials)
+    mat = jax.tree.map(lambda *v: jnp.stack(v)[mat_idx], *(m.validated() for m in frame.materials))
     return length, rot, sec, mat
+
+
+def _point_masses(frame: Frame) -> Float[Array, " k"]:
+    """The frame's point masses (kg), checked >= 0."""
+    return check_nonnegative("Frame.point_masses", frame.point_masses, "kg")
 
 
 @eqx.filter_jit
@@ -140,7 +149,7 @@ def point_mass_matrix(frame: Frame) -> Float[Array, "n n"]:
     mesh = frame_mesh(frame)
     diag = jnp.zeros(mesh.n_dof)
     idx = np.asarray([6 * k + c for k in frame.mass_nodes for c in range(3)], dtype=np.int64)
-    vals = jnp.repeat(frame.point_masses, 3)
+    vals = jnp.repeat(_point_masses(frame), 3)
     return jnp.diag(diag.at[idx].add(vals))
 
 
@@ -158,16 +167,33 @@ def assemble(frame: Frame) -> tuple[Float[Array, "n n"], Float[Array, "n n"]]:
 def frame_mass(frame: Frame) -> Float[Array, ""]:
     """Total mass (kg): tubes (rho A L summed over members) plus point masses."""
     length, _, sec, mat = _element_data(frame)
-    return jnp.sum(mat.density * sec.area * length) + jnp.sum(frame.point_masses)
+    return jnp.sum(mat.density * sec.area * length) + jnp.sum(_point_masses(frame))
 
 
 def with_sections(frame: Frame, sections) -> Frame:
-    """Return ``frame`` with its tuple of sections replaced (for design studies)."""
-    return eqx.tree_at(lambda f: f.sections, frame, tuple(sections))
+    """Return ``frame`` with its tuple of sections replaced (for design studies).
+
+    ``sections`` must give one :class:`CircularTube` or :class:`RectangularTube` per
+    section of the frame (in ``frame.section_names`` order). Their sizes are checked
+    (``ParameterError`` for concrete values, a run-time error for traced ones): diameters
+    and widths > 0, 0 < wall <= diameter/2 (circular) or < min(width, height)/2.
+    """
+    sections = tuple(sections)
+    if len(sections) != len(frame.sections):
+        raise ParameterError(
+            f"with_sections: the frame has {len(frame.sections)} sections {list(frame.section_names)}, "
+            f"got {len(sections)}"
+        )
+    for name, s in zip(frame.section_names, sections):
+        if not isinstance(s, (CircularTube, RectangularTube)):
+            raise ParameterError(
+                f"with_sections: section {name!r} must be a CircularTube or RectangularTube, got {type(s).__name__}"
+            )
+    return eqx.tree_at(lambda f: f.sections, frame, tuple(s.validated() for s in sections))
 
 
 @eqx.filter_jit
-def element_strain_energy(frame: Frame, u: Float[Array, "n"]) -> Float[Array, "e"]:
+def element_strain_energy(frame: Frame, u: Float[Array, " n"]) -> Float[Array, " e"]:
     """Strain energy ``½ u_eᵀ k_e u_e`` (J) of every element for global displacement ``u``."""
     ke, _ = element_matrices(frame)
     ue = u[frame_mesh(frame).dof_index]

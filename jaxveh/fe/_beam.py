@@ -12,21 +12,66 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ..params import float_field
+from .._core import float_field
+from ._validate import check_interval, check_positive, check_relation
+
+#: Relative slack on the wall-thickness limits, so that t = D/2 given in mm survives the
+#: conversion to m (one rounding of each value, ~1e-16 relative).
+WALL_RTOL = 1e-12
+
+
+#: An orientation vector whose component normal to the member is below this fraction of
+#: its length counts as parallel (the frame loader uses the same 1e-6).
+ORIENTATION_RTOL = 1e-6
 
 
 class Material(eqx.Module):
     """Isotropic linear-elastic material.
 
     Attributes:
-        youngs_modulus: E (Pa).
-        shear_modulus: G (Pa).
-        density: rho (kg/m^3).
+        youngs_modulus: E (Pa), > 0.
+        shear_modulus: G (Pa), > 0, with Poisson's ratio ``E / (2 G) − 1`` in (−1, 0.5)
+            (positive-definite isotropic elasticity), i.e. ``0 < E < 3 G``.
+        density: rho (kg/m^3), > 0.
+
+    Concrete values are validated on construction (``ParameterError`` naming the field);
+    traced values (inside ``jit``/``grad``) are checked at run time. Use
+    :meth:`from_poisson` to give Poisson's ratio instead of G.
     """
 
     youngs_modulus: Float[Array, ""] = float_field()
     shear_modulus: Float[Array, ""] = float_field()
     density: Float[Array, ""] = float_field()
+
+    def __init__(self, youngs_modulus, shear_modulus, density):
+        e = check_positive("Material.youngs_modulus", youngs_modulus, "Pa")
+        g = check_positive("Material.shear_modulus", shear_modulus, "Pa")
+        self.youngs_modulus = check_relation(
+            e,
+            lambda xp, E, G: ~(E < 3.0 * G),
+            "Material: Poisson's ratio E/(2G) - 1 must lie in (-1, 0.5), i.e. E < 3 G",
+            E=e,
+            G=g,
+        )
+        self.shear_modulus = g
+        self.density = check_positive("Material.density", density, "kg/m^3")
+
+    @classmethod
+    def from_poisson(cls, youngs_modulus, poisson_ratio, density) -> "Material":
+        """Material from E (Pa), Poisson's ratio ν in (−1, 0.5) and density (kg/m³):
+        ``G = E / (2 (1 + ν))``."""
+        nu = check_interval("Material.poisson_ratio", poisson_ratio, low=-1.0, high=0.5, low_open=True, high_open=True)
+        e = check_positive("Material.youngs_modulus", youngs_modulus, "Pa")
+        return cls(e, e / (2.0 * (1.0 + nu)), density)
+
+    @property
+    def poisson_ratio(self) -> Float[Array, ""]:
+        """ν = E / (2 G) − 1."""
+        return self.youngs_modulus / (2.0 * self.shear_modulus) - 1.0
+
+    def validated(self) -> "Material":
+        """The same material with every value checked (run-time checks when traced)."""
+        return Material(self.youngs_modulus, self.shear_modulus, self.density)
 
 
 class SectionProperties(eqx.Module):
@@ -47,21 +92,60 @@ class SectionProperties(eqx.Module):
     shear_area_z: Float[Array, "..."]
 
 
+def _circular(diameter, thickness):
+    d = check_positive("CircularTube.diameter", diameter, "m")
+    t = check_positive("CircularTube.thickness", thickness, "m")
+    t = check_relation(
+        t,
+        lambda xp, thickness, diameter: thickness > 0.5 * diameter * (1.0 + WALL_RTOL),
+        "CircularTube.thickness must lie in (0, diameter/2] (diameter/2 is a solid bar)",
+        thickness=t,
+        diameter=d,
+    )
+    return d, t
+
+
+def _rectangular(width, height, thickness):
+    b = check_positive("RectangularTube.width", width, "m")
+    h = check_positive("RectangularTube.height", height, "m")
+    t = check_positive("RectangularTube.thickness", thickness, "m")
+    t = check_relation(
+        t,
+        lambda xp, thickness, width, height: thickness >= 0.5 * xp.minimum(width, height) * (1.0 - WALL_RTOL),
+        "RectangularTube.thickness must lie in (0, min(width, height)/2)",
+        thickness=t,
+        width=b,
+        height=h,
+    )
+    return b, h, t
+
+
 class CircularTube(eqx.Module):
     """Thin- or thick-walled circular tube.
 
     Attributes:
-        diameter: outer diameter D (m).
+        diameter: outer diameter D (m), > 0.
         thickness: wall thickness t (m), 0 < t <= D/2 (t = D/2 is a solid bar).
+
+    Validated on construction (concrete values: ``ParameterError``) and again whenever
+    :meth:`properties` is evaluated (traced values: a run-time error, never NaN).
     """
 
     diameter: Float[Array, ""] = float_field()
     thickness: Float[Array, ""] = float_field()
 
+    def __init__(self, diameter, thickness):
+        self.diameter, self.thickness = _circular(diameter, thickness)
+
+    def validated(self) -> "CircularTube":
+        """The same section with its values checked (run-time checks when traced)."""
+        return CircularTube(self.diameter, self.thickness)
+
     def properties(self) -> SectionProperties:
         """Exact annulus constants; shear area A/2 (thin-walled tube)."""
-        ro = 0.5 * self.diameter
-        ri = ro - self.thickness
+        d, t = _circular(self.diameter, self.thickness)
+        ro = 0.5 * d
+        ri = ro - t
         area = jnp.pi * (ro**2 - ri**2)
         i = 0.25 * jnp.pi * (ro**4 - ri**4)
         return SectionProperties(area, i, i, 2.0 * i, 0.5 * area, 0.5 * area)
@@ -71,19 +155,29 @@ class RectangularTube(eqx.Module):
     """Rectangular hollow section, walls of uniform thickness.
 
     Attributes:
-        width: outer dimension along local y, b (m).
-        height: outer dimension along local z, h (m).
-        thickness: wall thickness t (m), 0 < t < min(b, h)/2.
+        width: outer dimension along local y, b (m), > 0.
+        height: outer dimension along local z, h (m), > 0.
+        thickness: wall thickness t (m), 0 < t < min(b, h)/2 (the Bredt-Batho torsion
+            constant needs a hollow section).
+
+    Validated on construction and in :meth:`properties`, as :class:`CircularTube`.
     """
 
     width: Float[Array, ""] = float_field()
     height: Float[Array, ""] = float_field()
     thickness: Float[Array, ""] = float_field()
 
+    def __init__(self, width, height, thickness):
+        self.width, self.height, self.thickness = _rectangular(width, height, thickness)
+
+    def validated(self) -> "RectangularTube":
+        """The same section with its values checked (run-time checks when traced)."""
+        return RectangularTube(self.width, self.height, self.thickness)
+
     def properties(self) -> SectionProperties:
         """Bending constants exact for the hollow rectangle; torsion by Bredt-Batho
         ``J = 4 A_m^2 t / p_m`` on the wall mid-line; shear area of the webs."""
-        b, h, t = self.width, self.height, self.thickness
+        b, h, t = _rectangular(self.width, self.height, self.thickness)
         bi, hi = b - 2.0 * t, h - 2.0 * t
         area = b * h - bi * hi
         iz = (h * b**3 - hi * bi**3) / 12.0
@@ -100,12 +194,30 @@ def direction_cosines(
 
     ``orientation`` is any global vector not parallel to the member; local y is its
     component orthogonal to the axis.
+
+    Zero-length members (coincident nodes, e.g. moved by an optimiser) and orientation
+    vectors parallel to the member are refused (``ParameterError``, or a run-time error
+    when traced) instead of giving NaN.
     """
     d = x2 - x1
     length = jnp.sqrt(jnp.sum(d * d))
+    length = check_relation(
+        length,
+        lambda xp, length: ~(length > 0.0),
+        "beam element has zero length (coincident nodes) or a non-finite node position",
+        length=length,
+    )
     ex = d / length
     y = orientation - jnp.dot(orientation, ex) * ex
-    ey = y / jnp.sqrt(jnp.sum(y * y))
+    ny = jnp.sqrt(jnp.sum(y * y))
+    ny = check_relation(
+        ny,
+        lambda xp, normal, orientation: ~(normal > ORIENTATION_RTOL * xp.sqrt(xp.sum(orientation * orientation))),
+        "member orientation vector is parallel to the member (local y undefined)",
+        normal=ny,
+        orientation=orientation,
+    )
+    ey = y / ny
     ez = jnp.cross(ex, ey)
     return length, jnp.stack([ex, ey, ez])
 

@@ -15,8 +15,7 @@ import equinox as eqx
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._config import check_x64
-from ..params import ParameterError, float_field, read_toml
+from .._core import ParameterError, check_x64, float_field, read_toml
 from ._beam import CircularTube, Material, RectangularTube
 
 Section = CircularTube | RectangularTube
@@ -73,7 +72,7 @@ class Frame(eqx.Module):
     material_names: tuple[str, ...] = eqx.field(static=True)
     materials: tuple[Material, ...]
     mass_nodes: tuple[int, ...] = eqx.field(static=True)
-    point_masses: Float[Array, "k"] = float_field()
+    point_masses: Float[Array, " k"] = float_field()
     interface: tuple[str, ...] = eqx.field(static=True)
     torsion_test: TorsionTest | None
     timoshenko: bool = eqx.field(static=True, default=False)
@@ -181,7 +180,10 @@ def _material(name: str, d: dict, where: str) -> Material:
         if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1.0 < nu < 0.5:
             raise ParameterError(f"{w}.nu = {nu!r} is out of range: allowed -1 < nu < 0.5")
         g = e / (2.0 * (1.0 + nu))
-    return Material(e, g, rho)
+    try:
+        return Material(e, g, rho)
+    except ParameterError as err:  # e.g. E >= 3 G: Poisson's ratio >= 0.5
+        raise ParameterError(f"{w}: {err}") from None
 
 
 def frame_from_dict(table: dict, where: str = "<dict>") -> Frame:
@@ -273,7 +275,9 @@ def frame_from_dict(table: dict, where: str = "<dict>") -> Frame:
             o = np.asarray(m["orientation"], dtype=float)
             d = (xyz[j] - xyz[i]) / length
             if o.shape != (3,) or np.linalg.norm(np.cross(o, d)) < 1e-6 * max(np.linalg.norm(o), 1e-300):
-                raise ParameterError(f"{w}.orientation must be 3 numbers not parallel to the member, got {m['orientation']!r}")
+                raise ParameterError(
+                    f"{w}.orientation must be 3 numbers not parallel to the member, got {m['orientation']!r}"
+                )
             m_orient.append(o / np.linalg.norm(o))
         else:
             m_orient.append(default_orientation(xyz, [(i, j)])[0])

@@ -16,9 +16,10 @@ import jax.scipy.linalg as jsl
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import ParameterError
+from .._core import ParameterError
 from ._assembly import assemble, frame_mass
 from ._frame import Frame
+from ._validate import check_relation
 
 
 class TorsionResult(eqx.Module):
@@ -42,8 +43,8 @@ class TorsionResult(eqx.Module):
 
 
 def solve_static(
-    K: Float[Array, "n n"], f: Float[Array, "n"], fixed: tuple[int, ...]
-) -> Float[Array, "n"]:
+    K: Float[Array, "n n"], f: Float[Array, " n"], fixed: tuple[int, ...]
+) -> Float[Array, " n"]:
     """Displacements solving ``K u = f`` with the DOF in ``fixed`` held at zero
     (Cholesky of the free-free partition; differentiable)."""
     free = np.setdiff1d(np.arange(K.shape[0]), np.asarray(fixed, dtype=np.int64))
@@ -69,17 +70,23 @@ def torsion_test(frame: Frame) -> TorsionResult:
     fixed, loaded = torsion_dofs(frame)
     K, _ = assemble(frame)
     t = frame.torsion_test
-    f = jnp.zeros(K.shape[0]).at[loaded].set(t.load)
+    load = check_relation(
+        t.load,
+        lambda xp, load: ~(xp.isfinite(load) & (load != 0.0)),
+        "TorsionTest.load must be a non-zero finite force (N)",
+        load=t.load,
+    )
+    f = jnp.zeros(K.shape[0]).at[loaded].set(load)
     u = solve_static(K, f, fixed)
     xyz = frame.node_xyz
     w = jnp.abs(xyz[frame.node_index(t.loaded), 1] - xyz[frame.node_index(t.front_support), 1])
-    delta = u[loaded] * jnp.sign(t.load)
-    stiffness = jnp.abs(t.load) * w**2 / delta
+    delta = u[loaded] * jnp.sign(load)
+    stiffness = jnp.abs(load) * w**2 / delta
     return TorsionResult(
         stiffness=stiffness,
         stiffness_nm_per_deg=stiffness * (jnp.pi / 180.0),
         deflection=delta,
-        torque=jnp.abs(t.load) * w,
+        torque=jnp.abs(load) * w,
         displacement=u.reshape(-1, 6),
         mass=frame_mass(frame),
     )
