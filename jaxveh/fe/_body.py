@@ -1,19 +1,21 @@
 """From a frame to a :class:`ModalBody`: nodal lumped masses, modes, invariants."""
 
+import math
+
 import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import ParameterError
-from ._assembly import assemble, mesh_xyz
+from .._core import ParameterError, as_float
+from ._assembly import assemble, frame_mesh, mesh_xyz
 from ._beam import CircularTube, Material
 from ._frame import Frame, frame_from_dict
-from ._invariants import ModalBody, modal_body
-from ._modal import free_free_modes
+from ._invariants import ModalBody, damping_parameters, modal_body
+from ._modal import N_RIGID, check_mode_count, free_free_modes
 
 
-def nodal_mass_data(M: Float[Array, "n6 n6"]) -> tuple[Float[Array, "n"], Float[Array, "n 3 3"]]:
+def nodal_mass_data(M: Float[Array, "n6 n6"]) -> tuple[Float[Array, " n"], Float[Array, "n 3 3"]]:
     """Nodal masses (kg) and inertia tensors (kg m²) from a lumped (6×6 block-diagonal)
     mass matrix: ``m_k = M[6k, 6k]``, ``J_k = M[6k+3:6k+6, 6k+3:6k+6]``."""
     n = M.shape[0] // 6
@@ -28,41 +30,53 @@ def split_modes(phi: Float[Array, "n6 N"]) -> tuple[Float[Array, "n 3 N"], Float
     return r[:, :3, :], r[:, 3:, :]
 
 
-@eqx.filter_jit
 def frame_modal_body(
     frame: Frame,
     n_modes: int,
     points: tuple[str, ...] | None = None,
     origin: Float[Array, "3"] | None = None,
-    alpha: float = 0.0,
-    beta: float = 0.01,
+    alpha=None,
+    beta=None,
+    damping_ratio=None,
 ) -> ModalBody:
     """Free-free modal truncation of ``frame`` packaged for the multibody library.
 
     Args:
         frame: a lumped-mass frame (the thesis's assumption).
-        n_modes: number of elastic modes kept.
+        n_modes: number of elastic modes kept, 1 <= n_modes <= 6 n - 6 for n mesh nodes.
         points: names of the nodes whose mode shapes are kept (default: the frame's
             interface nodes, e.g. the 32 hard points; all user nodes if it has none).
         origin: body-frame origin in frame coordinates (m); default the frame's origin.
-        alpha, beta: proportional damping ``D = α M + β K``.
+        alpha, beta, damping_ratio: damping, as :func:`~jaxveh.fe.damping_parameters`:
+            by default modal damping ζ = 0.025 on every mode (thesis section 7.3); giving
+            ``alpha`` (1/s) and/or ``beta`` (s) alone selects Rayleigh damping
+            ``α Me + β K``; ``damping_ratio`` with them adds both.
 
-    Body frame: the frame's axes, origin at ``origin``.
+    Body frame: the frame's axes, origin at ``origin``. Damping values and the origin are
+    passed to the jitted computation as arrays: new values never recompile.
     """
     if not frame.lumped_mass:
         raise ParameterError("frame_modal_body needs lumped_mass = true (nodal masses and inertias, section 5.4.2)")
+    names = tuple(points) if points is not None else (frame.interface or frame.node_names)
+    index = tuple(frame.node_index(n) for n in names)
+    check_mode_count(n_modes, frame_mesh(frame).n_dof - N_RIGID)
+    zeta, alpha, beta = damping_parameters(n_modes, damping_ratio, alpha, beta)
+    origin = jnp.zeros(3) if origin is None else as_float(origin)
+    if origin.shape != (3,):
+        raise ParameterError(f"origin must be 3 coordinates (m), got shape {origin.shape}")
+    return _frame_modal_body(frame, n_modes, names, index, origin, zeta, alpha, beta)
+
+
+@eqx.filter_jit
+def _frame_modal_body(frame, n_modes, names, index, origin, zeta, alpha, beta) -> ModalBody:
     K, M = assemble(frame)
-    freq, phi = free_free_modes(K, M, n_modes)
-    xyz = mesh_xyz(frame)
-    if origin is not None:
-        xyz = xyz - jnp.asarray(origin)[None, :]
+    _, phi = free_free_modes(K, M, n_modes)
+    xyz = mesh_xyz(frame) - origin[None, :]
     mass, inertia = nodal_mass_data(M)
     pt, pr = split_modes(phi)
-    names = points if points is not None else (frame.interface or frame.node_names)
     ke = phi.T @ K @ phi
     return modal_body(
-        xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), freq, tuple(names),
-        tuple(frame.node_index(n) for n in names), alpha, beta,
+        xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), names, index, damping_ratio=zeta, alpha=alpha, beta=beta
     )
 
 
@@ -92,10 +106,13 @@ def straight_tube_frame(
             names.append("mid")
         else:
             names.append(f"n{k}")
-    for name, v in (("diameter", diameter), ("thickness", thickness), ("youngs_modulus", youngs_modulus),
-                    ("shear_modulus", shear_modulus), ("density", density)):
-        if isinstance(v, (int, float)) and not v > 0.0:
-            raise ParameterError(f"{name} = {v!r} is out of range: allowed > 0")
+    length = float(length)  # node positions are built in Python (static topology)
+    if not 0.0 < length < math.inf:
+        raise ParameterError(f"length = {length!r} m is out of range: allowed (0, inf)")
+    # checked before the frame is built (ParameterError naming the field; run-time
+    # checks for traced values)
+    section = CircularTube(diameter, thickness)
+    material = Material(youngs_modulus, shear_modulus, density)
     table = {
         "frame": {"interface": ["start", "end"]},
         "materials": {"steel": {"E": 210.0, "G": 80.0, "density": 7850.0}},
@@ -108,7 +125,7 @@ def straight_tube_frame(
     return eqx.tree_at(
         lambda f: (f.sections, f.materials),
         frame,
-        ((CircularTube(diameter, thickness),), (Material(youngs_modulus, shear_modulus, density),)),
+        ((section,), (material,)),
     )
 
 
@@ -118,15 +135,19 @@ def straight_beam_body(
     n_elements: int = 10,
     diameter: float = 0.03,
     thickness: float = 0.002,
-    beta: float = 0.01,
+    beta=None,
+    *,
+    alpha=None,
+    damping_ratio=None,
 ) -> ModalBody:
     """A free-free straight steel tube as a :class:`ModalBody` (e.g. a flexible pendulum).
 
     Body frame: origin at the ``"start"`` end, x along the tube. Named points ``"start"``,
     ``"end"`` (and ``"mid"`` for even ``n_elements``). The circular section gives pairs of
     equal bending frequencies (y and z); the first elastic modes are bending pairs, then
-    torsion and axial modes.
+    torsion and axial modes. Damping as :func:`frame_modal_body` (default ζ = 0.025 per
+    mode; ``beta`` alone, e.g. ``beta=0.0``, selects Rayleigh damping).
     """
     frame = straight_tube_frame(length, n_elements, diameter, thickness)
     points = tuple(n for n in ("start", "mid", "end") if n in frame.node_names)
-    return frame_modal_body(frame, n_modes, points=points, beta=beta)
+    return frame_modal_body(frame, n_modes, points=points, alpha=alpha, beta=beta, damping_ratio=damping_ratio)

@@ -21,7 +21,7 @@ import equinox as eqx
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import ParameterError, float_field
+from .._core import ParameterError, float_field
 from ._body import nodal_mass_data, split_modes
 from ._invariants import ModalBody, modal_body
 from ._modal import free_free_modes
@@ -69,7 +69,9 @@ def external_model_from_arrays(
     if len(set(node_ids)) != n:
         raise ParameterError(f"{where}: node_ids contains duplicates")
     if dof_map.shape != (K.shape[0], 2):
-        raise ParameterError(f"{where}: dof_map must have shape ({K.shape[0]}, 2) (node_id, component), got {dof_map.shape}")
+        raise ParameterError(
+            f"{where}: dof_map must have shape ({K.shape[0]}, 2) (node_id, component), got {dof_map.shape}"
+        )
     if K.shape[0] != 6 * n:
         raise ParameterError(f"{where}: {K.shape[0]} DOF for {n} nodes; every node must carry six DOF (ux..rz)")
     for name, A in (("K", K), ("M", M)):
@@ -109,7 +111,9 @@ def load_external_model(
             if missing:
                 raise ParameterError(f"{path}: missing array(s) {missing}")
             names = d["node_names"] if "node_names" in d else None
-            return external_model_from_arrays(d["K"], d["M"], d["node_ids"], d["node_xyz"], d["dof_map"], names, str(path))
+            return external_model_from_arrays(
+                d["K"], d["M"], d["node_ids"], d["node_xyz"], d["dof_map"], names, str(path)
+            )
     if mass is None or nodes is None or dofs is None:
         raise ParameterError("a Matrix Market stiffness file needs mass=, nodes= and dofs= files too")
     from scipy.io import mmread
@@ -126,15 +130,21 @@ def load_external_model(
 
 
 def external_modal_body(
-    model: ExternalModel, n_modes: int, points: tuple[str, ...], alpha: float = 0.0, beta: float = 0.01
+    model: ExternalModel,
+    n_modes: int,
+    points: tuple[str, ...],
+    alpha=None,
+    beta=None,
+    damping_ratio=None,
 ) -> ModalBody:
     """Free-free modal truncation of an imported model as a :class:`ModalBody` (body
-    frame = the model's axes and origin)."""
-    freq, phi = free_free_modes(model.K, model.M, n_modes)
+    frame = the model's axes and origin). Damping as
+    :func:`~jaxveh.fe.frame_modal_body` (default ζ = 0.025 on every mode)."""
+    _, phi = free_free_modes(model.K, model.M, n_modes)
     mass, inertia = nodal_mass_data(model.M)
     pt, pr = split_modes(phi)
     ke = phi.T @ model.K @ phi
     return modal_body(
-        model.node_xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), freq, tuple(points),
-        tuple(model.node_index(p) for p in points), alpha, beta,
+        model.node_xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), tuple(points),
+        tuple(model.node_index(p) for p in points), damping_ratio=damping_ratio, alpha=alpha, beta=beta,
     )
