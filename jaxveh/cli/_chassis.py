@@ -5,10 +5,12 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from ..params import ParameterError
+from .._core import ParameterError
 from ._common import emit_json, fail
 
-app = typer.Typer(help="Chassis finite-element model: torsion test, free-free modes, Craig-Bampton.", no_args_is_help=True)
+app = typer.Typer(
+    help="Chassis finite-element model: torsion test, free-free modes, Craig-Bampton.", no_args_is_help=True
+)
 
 FrameOpt = typer.Option(None, "--frame", help="frame TOML file (default: the shipped FSAE 2009 frame)")
 JsonOpt = typer.Option(False, "--json", help="print only JSON on stdout")
@@ -21,7 +23,7 @@ def _frame(path: Path | None):
 
 
 @app.command()
-def torsion(frame: Path = FrameOpt, json: bool = JsonOpt) -> None:
+def torsion(frame: Path = FrameOpt, as_json: bool = JsonOpt) -> None:
     """Static torsion test (thesis section 6.2.2): stiffness in Nm/deg and frame mass."""
     from .. import fe
 
@@ -35,7 +37,7 @@ def torsion(frame: Path = FrameOpt, json: bool = JsonOpt) -> None:
         "deflection_mm": 1e3 * float(r.deflection),
         "torque_Nm": float(r.torque),
     }
-    if json:
+    if as_json:
         emit_json(out)
     else:
         typer.echo(f"torsional stiffness {out['torsional_stiffness_Nm_per_deg']:.1f} Nm/deg "
@@ -48,23 +50,42 @@ def modes(
     n: int = typer.Option(6, "--n", help="number of elastic modes"),
     method: str = typer.Option("truncation", "--method", help="truncation | craig-bampton"),
     n_fixed: int = typer.Option(60, "--n-fixed", help="fixed-interface modes (craig-bampton)"),
-    json: bool = JsonOpt,
+    damping_ratio: float | None = typer.Option(
+        None, "--damping-ratio", help="modal damping ratio of every mode, [0, 1) (default 0.025 unless --alpha/--beta)"
+    ),
+    alpha: float | None = typer.Option(None, "--alpha", help="Rayleigh mass-proportional damping (1/s), >= 0"),
+    beta: float | None = typer.Option(None, "--beta", help="Rayleigh stiffness-proportional damping (s), >= 0"),
+    as_json: bool = JsonOpt,
 ) -> None:
-    """Lowest free-free elastic modes with automatic labels (thesis Table 6.4)."""
+    """Lowest free-free elastic modes with automatic labels (thesis Table 6.4) and the
+    damping ratio of each uncoupled mode (default modal damping 0.025, thesis 7.3;
+    --alpha/--beta alone select Rayleigh damping alpha M + beta K)."""
     from .. import fe
 
     try:
+        zeta_args = {"damping_ratio": damping_ratio, "alpha": alpha, "beta": beta}
+        fe.damping_parameters(1, **zeta_args)  # named errors before the eigen-solve
         fr = _frame(frame)
         f, phi = fe.chassis_modes(fr, n, method, n_fixed)
         labels = fe.mode_labels(fr, phi)
+        zeta = np.asarray(fe.modal_damping_ratios(f, **zeta_args))
     except ParameterError as e:
-        fail(f"--n/--method/--frame: {e}")
-    out = {"method": method, "modes": [{"mode": k + 1, "freq_hz": float(f[k]), "label": labels[k]} for k in range(n)]}
-    if json:
+        fail(f"--n/--method/--frame/--damping-ratio/--alpha/--beta: {e}")
+    used, a, b = fe.damping_parameters(1, **zeta_args)
+    out = {
+        "method": method,
+        "damping": {"damping_ratio": float(used[0]), "alpha": float(a), "beta": float(b)},
+        "modes": [
+            {"mode": k + 1, "freq_hz": float(f[k]), "label": labels[k], "damping_ratio": float(zeta[k])}
+            for k in range(n)
+        ],
+    }
+    if as_json:
         emit_json(out)
     else:
         for m in out["modes"]:
-            typer.echo(f"{m['mode']:3d} {m['freq_hz']:9.2f} Hz  {m['label']}")
+            over = "  (over-critical)" if m["damping_ratio"] >= 1.0 else ""
+            typer.echo(f"{m['mode']:3d} {m['freq_hz']:9.2f} Hz  zeta {m['damping_ratio']:.4f}{over}  {m['label']}")
 
 
 @app.command()
@@ -72,7 +93,7 @@ def compare(
     frame: Path = FrameOpt,
     n: int = typer.Option(20, "--n", help="number of modes compared"),
     n_fixed: int = typer.Option(60, "--n-fixed", help="fixed-interface modes in the Craig-Bampton basis"),
-    json: bool = JsonOpt,
+    as_json: bool = JsonOpt,
 ) -> None:
     """Modal truncation vs Craig-Bampton: NRFD and MAC (thesis Fig. 6.9)."""
     from .. import fe
@@ -82,7 +103,7 @@ def compare(
     except ParameterError as e:
         fail(f"--n/--n-fixed/--frame: {e}")
     out = {k: np.asarray(v).tolist() for k, v in c.items() if k != "mac"}
-    if json:
+    if as_json:
         emit_json(out)
     else:
         for k in range(n):
