@@ -16,7 +16,7 @@ import json
 
 import numpy as np
 
-from jaxveh.params import load_vehicle_data, hard_points_vehicle_frame, SPRUNG_HARD_POINTS, HARD_POINT_NAMES
+from jaxveh.params import HARD_POINT_NAMES, SPRUNG_HARD_POINTS, hard_points_vehicle_frame, load_vehicle_data
 
 vd = load_vehicle_data()
 hp = hard_points_vehicle_frame(vd)

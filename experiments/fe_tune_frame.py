@@ -78,12 +78,15 @@ def main():
     t0 = time.time()
     history = []
     for i in range(args.steps):
-        (l, (m, k, f1, share)), g = step_fn(x)
+        (loss, (m, k, f1, share)), g = step_fn(x)
         upd, state = opt.update(g, state)
         x = optax.apply_updates(x, upd)
-        history.append([i, float(l), float(m), float(k), float(f1), float(share)])
+        history.append([i, float(loss), float(m), float(k), float(f1), float(share)])
         if i % 20 == 0 or i == args.steps - 1:
-            print(f"{i:4d} loss {float(l):.3e} mass {float(m):6.2f} kg  k {float(k):6.1f} Nm/deg  f1 {float(f1):6.2f} Hz  energy centroid {float(share):+.2f}")
+            print(
+                f"{i:4d} loss {float(loss):.3e} mass {float(m):6.2f} kg  k {float(k):6.1f} Nm/deg  "
+                f"f1 {float(f1):6.2f} Hz  energy centroid {float(share):+.2f}"
+            )
     print(f"{time.time() - t0:.1f} s")
     sections = {
         n: [round(float(jnp.exp(d)) * 1e3, 2), round(float(jnp.exp(t)) * 1e3, 2)]
@@ -91,7 +94,8 @@ def main():
     }
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "sections.json").write_text(json.dumps(sections, indent=2))
-    np.savetxt(args.out / "history.csv", np.asarray(history), delimiter=",", header="step,loss,mass_kg,k_Nm_per_deg,f1_hz,mode1_energy_centroid")
+    header = "step,loss,mass_kg,k_Nm_per_deg,f1_hz,mode1_energy_centroid"
+    np.savetxt(args.out / "history.csv", np.asarray(history), delimiter=",", header=header)
     for n, (d, t) in sections.items():
         print(f'[sections.{n}]\nshape = "circular"\ndiameter = {d}\nthickness = {t}\n')
 

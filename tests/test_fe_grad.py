@@ -6,6 +6,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers import assert_grad_matches_fd
+from jax.test_util import check_grads
 from test_fe_reduction import box_frame
 
 import jaxveh.fe as fe
@@ -36,6 +37,7 @@ def first_frequencies(frame, x):
     return fe.free_free_modes(K, M, 4)[0]
 
 
+@pytest.mark.slow
 def test_frequency_gradient_matches_fd(frame):
     f = jax.jit(lambda x: first_frequencies(frame, x)[0])
     assert_grad_matches_fd(f, X0, h=H_FD, rtol=RTOL_FD)
@@ -43,6 +45,7 @@ def test_frequency_gradient_matches_fd(frame):
     assert_grad_matches_fd(f3, X0, h=H_FD, rtol=RTOL_FD)
 
 
+@pytest.mark.slow
 def test_frequency_forward_and_reverse_agree(frame):
     f = lambda x: first_frequencies(frame, x)
     J_fwd = jax.jacfwd(f)(jnp.asarray(X0))
@@ -77,6 +80,7 @@ def test_invariant_gradients_match_fd(frame):
     assert_grad_matches_fd(jax.jit(inv), X0, h=H_FD, rtol=RTOL_FD)
 
 
+@pytest.mark.slow
 def test_repeated_eigenvalues_give_finite_exact_cluster_gradient():
     """A circular tube has equal bending frequencies in y and z: per-mode derivatives
     are finite and the pair's sum is exact."""
@@ -131,3 +135,30 @@ def test_gradient_wrt_node_coordinates_and_material(frame):
         for i, dx in enumerate((np.array([1e-6, 0.0]), np.array([0.0, 1e8])))
     ]
     np.testing.assert_allclose(g, fd, rtol=1e-5)
+
+
+def test_check_grads_sections_mass_and_torsion(frame):
+    """``jax.test_util.check_grads`` (forward and reverse mode) w.r.t. sizes in mm."""
+    props = lambda x: jnp.stack(jax.tree.leaves(fe.CircularTube(1e-3 * x[0], 1e-3 * x[1]).properties()))
+    rect = lambda x: jnp.stack(jax.tree.leaves(fe.RectangularTube(1e-3 * x[0], 1e-3 * x[1], 1e-3 * x[2]).properties()))
+    check_grads(lambda x: 1e6 * props(x), (jnp.asarray([25.4, 1.6]),), order=2, modes=("fwd", "rev"), eps=1e-4)
+    check_grads(lambda x: 1e6 * rect(x), (jnp.asarray([20.0, 30.0, 1.2]),), order=2, modes=("fwd", "rev"), eps=1e-4)
+    mass = jax.jit(lambda x: fe.frame_mass(sized(frame, 1e-3 * x)))
+    check_grads(mass, (jnp.asarray(X0 * 1e3),), order=1, modes=("fwd", "rev"), eps=1e-4)
+    k = jax.jit(lambda x: fe.torsion_test(sized(frame, 1e-3 * x)).stiffness_nm_per_deg)
+    check_grads(k, (jnp.asarray(X0 * 1e3),), order=1, modes=("fwd", "rev"), eps=1e-4, rtol=1e-6)
+
+
+def test_check_grads_invariants_wrt_mode_shapes():
+    """Invariants (with the rotary-inertia terms) are polynomial in the mode shapes."""
+    rng = np.random.default_rng(2)
+    n, N = 4, 2
+    xyz, m = jnp.asarray(rng.normal(size=(n, 3))), jnp.asarray(rng.uniform(0.5, 2.0, n))
+    J = jnp.asarray(np.broadcast_to(np.diag([0.2, 0.3, 0.4]), (n, 3, 3)).copy())
+
+    def f(pt, pr):
+        inv = fe.modal_invariants(xyz, m, J, pt, pr)
+        return jnp.concatenate([inv.C4.ravel(), inv.C5.ravel(), inv.Cr0.ravel(), inv.Me.ravel()])
+
+    args = (jnp.asarray(rng.normal(size=(n, 3, N))), jnp.asarray(rng.normal(size=(n, 3, N))))
+    check_grads(jax.jit(f), args, order=2, modes=("fwd", "rev"))

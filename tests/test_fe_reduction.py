@@ -57,7 +57,8 @@ def test_free_free_modes_match_scipy(box):
     w = scipy.linalg.eigh(np.asarray(K), np.asarray(M), eigvals_only=True)
     np.testing.assert_allclose(f, np.sqrt(w[6:14]) / (2 * np.pi), rtol=RTOL_EIG)
     np.testing.assert_allclose(phi.T @ M @ phi, np.eye(8), atol=1e-10)
-    np.testing.assert_allclose(phi.T @ K @ phi, np.diag((2 * np.pi * np.asarray(f)) ** 2), atol=1e-6 * float(f[-1]) ** 2)
+    omega2 = (2 * np.pi * np.asarray(f)) ** 2
+    np.testing.assert_allclose(phi.T @ K @ phi, np.diag(omega2), atol=1e-6 * omega2[-1])
 
 
 def test_craig_bampton_reproduces_low_modes_and_bounds_them(box):
@@ -74,6 +75,7 @@ def test_craig_bampton_reproduces_low_modes_and_bounds_them(box):
     np.testing.assert_allclose(cb.modes.T @ M @ cb.modes, np.eye(6), atol=1e-9)
 
 
+@pytest.mark.slow
 def test_craig_bampton_converges_with_fixed_modes(box):
     frame, K, M = box
     f, _ = fe.free_free_modes(K, M, 12)

@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import ParameterError
+from .._core import ParameterError
 from ._assembly import assemble, element_centres, element_strain_energy, frame_mesh, mesh_xyz
 from ._body import nodal_mass_data
 from ._craig_bampton import craig_bampton
@@ -33,7 +33,7 @@ def interface_nodes(frame: Frame) -> tuple[int, ...]:
 @eqx.filter_jit
 def chassis_modes(
     frame: Frame, n_modes: int, method: str = "truncation", n_fixed: int = DEFAULT_N_FIXED
-) -> tuple[Float[Array, "n"], Float[Array, "dof n"]]:
+) -> tuple[Float[Array, " n"], Float[Array, "dof n"]]:
     """Lowest ``n_modes`` elastic free-free modes (Hz, mass-normalised shapes) by modal
     truncation or by orthogonalised Craig-Bampton with the frame's interface nodes."""
     if method not in METHODS:

@@ -18,7 +18,7 @@ import jax.scipy.linalg as jsl
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..params import ParameterError
+from .._core import ParameterError
 from ._modal import N_RIGID, check_mode_count, eigenvalue_to_hz, generalised_eigh
 
 
@@ -33,10 +33,10 @@ class CraigBampton(eqx.Module):
         fixed_interface_hz: frequencies of the fixed-interface modes (Hz), (n_fixed,).
     """
 
-    frequencies_hz: Float[Array, "n"]
+    frequencies_hz: Float[Array, " n"]
     modes: Float[Array, "dof n"]
     basis: Float[Array, "dof r"]
-    fixed_interface_hz: Float[Array, "k"]
+    fixed_interface_hz: Float[Array, " k"]
 
 
 def boundary_dofs(node_indices: tuple[int, ...], n_dof: int) -> tuple[np.ndarray, np.ndarray]:

@@ -18,8 +18,9 @@ axial                   (P_k, 0, 0)                              stretching alon
 (y, z measured from the centre of mass, in m). The family whose fitted part carries most of
 the mode's kinetic energy names the mode; if no family explains at least
 :data:`LOCAL_SHARE` of it the mode is "local", followed by the name of the user node
-nearest to the largest nodal translation (e.g. ``local (main_hoop_top_left)``). A "front" or "rear" prefix is added when the
-elastic strain energy is concentrated in that end: its x-centroid lies beyond
+nearest to the largest nodal translation (e.g. ``local (main_hoop_top_left)``). A "front"
+or "rear" prefix is added when the elastic strain energy is concentrated in that end: its
+x-centroid lies beyond
 :data:`REGION_THRESHOLD` of the half length from the middle.
 """
 

@@ -21,6 +21,6 @@ def mac(
     return cross**2 / (na[:, None] * nb[None, :])
 
 
-def nrfd(f_reference: Float[Array, "n"], f_other: Float[Array, "n"]) -> Float[Array, "n"]:
+def nrfd(f_reference: Float[Array, " n"], f_other: Float[Array, " n"]) -> Float[Array, " n"]:
     """Normalised relative frequency difference ``|f_other − f_ref| / f_ref`` (Fig. 6.9a)."""
     return jnp.abs(f_other - f_reference) / f_reference

@@ -19,7 +19,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ..params import ParameterError
+from .._core import ParameterError
 
 #: Relative eigenvalue gap below which two eigenvalues count as repeated (see module doc).
 DEGENERACY_RTOL = 1e-6
@@ -28,7 +28,7 @@ N_RIGID = 6
 
 
 @jax.custom_jvp
-def safe_eigh(a: Float[Array, "n n"]) -> tuple[Float[Array, "n"], Float[Array, "n n"]]:
+def safe_eigh(a: Float[Array, "n n"]) -> tuple[Float[Array, " n"], Float[Array, "n n"]]:
     """Eigenvalues (ascending) and orthonormal eigenvectors of symmetric ``a``,
     with finite derivatives at repeated eigenvalues (module docstring)."""
     w, v = jnp.linalg.eigh(a)
@@ -49,7 +49,7 @@ def _safe_eigh_jvp(primals, tangents):
 
 def generalised_eigh(
     K: Float[Array, "n n"], M: Float[Array, "n n"]
-) -> tuple[Float[Array, "n"], Float[Array, "n n"]]:
+) -> tuple[Float[Array, " n"], Float[Array, "n n"]]:
     """All eigenpairs of ``K φ = λ M φ`` (``M`` positive definite): ``λ`` (rad²/s²)
     ascending and mass-normalised ``Φ`` (columns)."""
     L = jnp.linalg.cholesky(M)
@@ -60,7 +60,7 @@ def generalised_eigh(
     return w, phi
 
 
-def eigenvalue_to_hz(w: Float[Array, "n"]) -> Float[Array, "n"]:
+def eigenvalue_to_hz(w: Float[Array, " n"]) -> Float[Array, " n"]:
     """Natural frequency (Hz) from an eigenvalue ω² (rad²/s²); 0 for ω² <= 0, with a
     finite derivative there (double-where)."""
     pos = w > 0.0
@@ -78,7 +78,7 @@ def check_mode_count(n_modes: int, available: int, what: str = "free-free elasti
 
 def free_free_modes(
     K: Float[Array, "n n"], M: Float[Array, "n n"], n_modes: int
-) -> tuple[Float[Array, "m"], Float[Array, "n m"]]:
+) -> tuple[Float[Array, " m"], Float[Array, "n m"]]:
     """Modal truncation: the ``n_modes`` lowest elastic free-free modes.
 
     The six rigid-body (zero-energy) modes are removed. Returns natural frequencies (Hz)
