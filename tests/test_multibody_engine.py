@@ -201,3 +201,33 @@ def test_linearised_spring_mass_chain_matches_closed_form():
     freq = np.sort(np.abs(np.linalg.eigvals(np.asarray(lin.A)).imag))[::2]
     expected = 2 * np.sqrt(k / m) * np.sin((2 * np.arange(1, 4) - 1) * np.pi / 14)
     np.testing.assert_allclose(freq[freq > 1e-3], expected, rtol=1e-10)
+
+
+def test_static_trim_of_the_yaw_table_and_its_implicit_gradient():
+    """Held rack ``u``: the equilibrium yaw solves ``k_t psi = k_s a (u cos psi - b sin psi)``;
+    d psi / d k_t by the implicit-function adjoint equals the closed form's derivative."""
+    k_t, k_s, a, b, u = 40.0, 2000.0, 0.3, 0.35, 0.02
+    system, params, springs = _yaw_table(k_t, k_s, a, b)
+    rack = lambda t: jnp.full((1,), u)  # noqa: E731
+    trim = mb.trim(system, params, jnp.zeros(1), inputs=rack, elements=springs)
+    f = lambda s, kt: kt * s - k_s * a * (u * np.cos(s) - b * np.sin(s))  # noqa: E731
+    root = scipy.optimize.brentq(lambda s: f(s, k_t), -1.0, 1.0)
+    assert float(trim.q[0]) == pytest.approx(root, abs=1e-10)
+    assert float(trim.residual) < mb.TRIM_ATOL
+
+    def yaw(kt):
+        els = (eqx.tree_at(lambda e: e.kt, springs[0], kt),) + springs[1:]
+        return mb.trim(system, params, jnp.zeros(1), inputs=rack, elements=els).q[0]
+
+    dpsi = float(jax.grad(yaw)(jnp.asarray(k_t)))
+    dfds = k_t + k_s * a * (u * np.sin(root) + b * np.cos(root))
+    assert dpsi == pytest.approx(-root / dfds, rel=1e-7)
+
+
+def test_trim_counts_unknowns_and_reports_failure():
+    system, params, springs = _yaw_table()
+    with pytest.raises(ValueError, match="as many free unknowns as equations"):
+        mb.trim(system, params, jnp.zeros(1), hold_z=(), inputs=lambda t: jnp.zeros(1), elements=springs)
+    with pytest.raises(mb.TrimError, match="equilibrium not found"):
+        mb.trim(system, params, jnp.zeros(1), inputs=lambda t: jnp.zeros(1), max_steps=1,
+                elements=(mb.TorsionSpring.between(system, "O", "hub", axis=(0, 0, 1), kt=40.0, ct=0.0, phi0=0.5),))

@@ -100,6 +100,12 @@ from ._simulate import (
     simulate as simulate,
     vector_field as vector_field,
 )
+from ._trim import (
+    TRIM_ATOL as TRIM_ATOL,
+    Trim as Trim,
+    TrimError as TrimError,
+    trim as trim,
+)
 from ._system import (
     GROUND as GROUND,
     System as System,
