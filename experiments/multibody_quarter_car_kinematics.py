@@ -24,13 +24,13 @@ import numpy as np  # noqa: E402
 
 import jaxveh  # noqa: E402,F401  (float64)
 from jaxveh import multibody as mb  # noqa: E402
-from jaxveh.multibody import _examples as ex  # noqa: E402
+from jaxveh import vehicle
 
 DEG = 180.0 / np.pi
 
 
 def sweeps(system, params):
-    kin = jax.jit(jax.vmap(lambda b, r: ex.quarter_car_kinematics(system, params, b, r)[1]))
+    kin = jax.jit(jax.vmap(lambda b, r: vehicle.quarter_car_kinematics(system, params, b, r)[1]))
     bump = np.linspace(-0.025, 0.025, 51)
     rack = np.linspace(-0.02, 0.02, 41)
     b_out = kin(jnp.asarray(bump), jnp.zeros_like(jnp.asarray(bump)))
@@ -50,20 +50,20 @@ def _masked(out):
 
 def gradients(system, params):
     """Kinematic gradients at design from R and S b, and by finite differences."""
-    q, _ = ex.quarter_car_kinematics(system, params, 0.0, 0.0)
+    q, _ = vehicle.quarter_car_kinematics(system, params, 0.0, 0.0)
     inputs = lambda t: jnp.reshape(t, (1,))  # noqa: E731  unit rack rate at rack = 0
     proj = mb.projection(system, params, q, 0.0, inputs)
     bt = mb.velocity_matrix(system, params, q)
 
     def outputs(qq):
-        camber, toe = ex.wheel_angles(system, params, qq)
+        camber, toe = vehicle.wheel_angles(system, params, qq)
         return jnp.stack([camber * DEG, toe * DEG, 2.0 * qq[1] * 1e3, qq[0] * 1e3])
 
     bump_col = bt @ proj.R[:, 0]
     g_bump = np.asarray(jax.jvp(outputs, (q,), (bump_col,))[1]) / float(bump_col[2]) * 1e-3  # per mm
     g_rack = np.asarray(jax.jvp(outputs, (q,), (bt @ proj.Sb,))[1]) * 1e-3
 
-    kin = jax.jit(lambda b, r: outputs(ex.quarter_car_kinematics(system, params, b, r)[0]))
+    kin = jax.jit(lambda b, r: outputs(vehicle.quarter_car_kinematics(system, params, b, r)[0]))
     h = 1e-5
     fd_bump = np.asarray(kin(h, 0.0) - kin(-h, 0.0)) / (2 * h) * 1e-3
     fd_rack = np.asarray(kin(0.0, h) - kin(0.0, -h)) / (2 * h) * 1e-3
@@ -82,7 +82,9 @@ def plot(bump, b_out, rack, r_out, path):
     ax[0, 1].plot(bmm, b_out["toe"] * DEG)
     ax[0, 1].set(xlabel="wheel-centre travel [mm]", ylabel="toe-in [deg]", title="(b) toe, bump")
     ax[0, 2].plot(bmm, (b_out["track"] - 1.26) * 1e3)
-    ax[0, 2].set(xlabel="wheel-centre travel [mm]", ylabel="track change (2 x half track) [mm]", title="(c) track, bump")
+    ax[0, 2].set(
+        xlabel="wheel-centre travel [mm]", ylabel="track change (2 x half track) [mm]", title="(c) track, bump"
+    )
     rmm = rack * 1e3
     ax[1, 0].plot(rmm, r_out["toe"] * DEG)
     ax[1, 0].set(xlabel="rack travel [mm]", ylabel="toe-in (steer) [deg]", title="(d) steer angle, steering")
@@ -102,7 +104,7 @@ def main():
     parser.add_argument("--out", type=Path, default=Path("results/multibody_quarter_car"))
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    system, params = ex.quarter_car()
+    system, params = vehicle.quarter_car()
     bump, b_out, rack, r_out = sweeps(system, params)
     with open(args.out / "bump.csv", "w", newline="") as f:
         w = csv.writer(f)

@@ -171,9 +171,11 @@ def test_linearised_double_pendulum_matches_closed_form():
     eig = np.sort(np.abs(np.linalg.eigvals(np.asarray(lin.A)).imag))[::2]
     np.testing.assert_allclose(eig**2, w2, rtol=1e-9)
     q_of = mb.chart(system, params, q)
-    f = lambda x, w: mb.minimal_rates(system, params, q_of, x[:2], x[2:], jnp.zeros(0), w, external=torque, with_args=True)  # noqa: E731
-    x0, h = jnp.zeros(4), 1e-6
-    fd_a = np.stack([(f(x0.at[i].set(h), jnp.zeros(1)) - f(x0.at[i].set(-h), jnp.zeros(1))) / (2 * h) for i in range(4)], 1)
+    def f(x, w):
+        return mb.minimal_rates(system, params, q_of, x[:2], x[2:], jnp.zeros(0), w, external=torque, with_args=True)
+
+    x0, h, w0 = jnp.zeros(4), 1e-6, jnp.zeros(1)
+    fd_a = np.stack([(f(x0.at[i].set(h), w0) - f(x0.at[i].set(-h), w0)) / (2 * h) for i in range(4)], 1)
     fd_b = (f(x0, jnp.full((1,), h)) - f(x0, jnp.full((1,), -h))) / (2 * h)
     np.testing.assert_allclose(lin.A, fd_a, atol=1e-6)
     np.testing.assert_allclose(lin.B[:, 0], fd_b, atol=1e-6)

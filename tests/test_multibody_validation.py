@@ -8,7 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxveh import ParameterError
+from jaxveh import ParameterError, vehicle
 from jaxveh import multibody as mb
 from jaxveh.multibody import _examples as ex
 
@@ -39,11 +39,11 @@ def test_bad_body_values_are_named(pendulum, where, value, message):
 
 
 def test_link_length_and_coupling_are_checked():
-    system, params = ex.quarter_car()
+    system, params = vehicle.quarter_car()
     k = system.joint_names.index("track_rod")
     bad = eqx.tree_at(lambda p: p.joints[k].length, params, jnp.asarray(0.0))
     with pytest.raises(ParameterError, match=r"link 'track_rod' length \(m\) must lie in \(0, inf\)"):
-        mb.assemble(system, bad, ex.quarter_car_design_q(system), inputs=lambda t: jnp.zeros((1,)))
+        mb.assemble(system, bad, vehicle.quarter_car_design_q(system), inputs=lambda t: jnp.zeros((1,)))
     fsystem, fparams = ex.flexible_pendulum()
     bad = eqx.tree_at(lambda p: p.bodies[0].coupling, fparams, jnp.asarray(1.5))
     with pytest.raises(ParameterError, match=r"body 'beam' coupling must lie in \[0, 1\]; got 1.5"):

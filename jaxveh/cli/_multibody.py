@@ -63,8 +63,8 @@ def inspect(
     in rad and rad/s; parameters m1, m2 (kg), J1, J2 (kg m^2), l1, a1, a2 (m), g (m/s^2).
     """
     from ..multibody import AssemblyError
-    from ..multibody._examples import inspect_example
     from ..params import ParameterError
+    from ._inspect import inspect_example
 
     values = _parse_values(list(ctx.args))
     try:

@@ -262,7 +262,11 @@ def _add_modal_rotation(system, params, out, modal_values):
 def _skew_batch(w):
     z = jnp.zeros_like(w[:, 0])
     return jnp.stack(
-        [jnp.stack([z, -w[:, 2], w[:, 1]], -1), jnp.stack([w[:, 2], z, -w[:, 0]], -1), jnp.stack([-w[:, 1], w[:, 0], z], -1)],
+        [
+            jnp.stack([z, -w[:, 2], w[:, 1]], -1),
+            jnp.stack([w[:, 2], z, -w[:, 0]], -1),
+            jnp.stack([-w[:, 1], w[:, 0], z], -1),
+        ],
         axis=1,
     )
 

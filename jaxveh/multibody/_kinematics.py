@@ -162,7 +162,9 @@ def _joint_layout(system: System):
     p_idx = np.asarray([jp[0] for jp in system.joint_points], dtype=int)
     q_idx = np.asarray([jp[1] for jp in system.joint_points], dtype=int)
     links = [k for k, kind in enumerate(system.joint_kind) if kind == "link"]
-    sph = [(k, c) for k, kind in enumerate(system.joint_kind) if kind == "spherical" for c in system.joint_components[k]]
+    sph = [
+        (k, c) for k, kind in enumerate(system.joint_kind) if kind == "spherical" for c in system.joint_components[k]
+    ]
     revs = [k for k, kind in enumerate(system.joint_kind) if kind == "revolute"]
     grouped = [(k, 0) for k in links] + sph + [(k, r) for k in revs for r in range(5)]
     ordered = [(k, c) for k, kind in enumerate(system.joint_kind) for c in (

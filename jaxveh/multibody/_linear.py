@@ -14,9 +14,9 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
+from ._kinematics import velocity_matrix
 from ._projection import Inputs, dynamics, projection
 from ._simulate import project_coordinates
-from ._kinematics import velocity_matrix
 from ._system import System, SystemParams, checked_params
 
 #: Newton iterations of the chart ``q(s)``: two give exact first and second derivatives at

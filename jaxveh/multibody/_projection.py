@@ -19,9 +19,9 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from ._dynamics import internal_forces, mass_matrix
+from ._errors import RedundantConstraintError, SingularMassMatrixError
 from ._forces import Kinematics, element_forces, generalised_forces, kinematics
 from ._inputs import AbstractInputs, as_inputs
-from ._errors import RedundantConstraintError, SingularMassMatrixError
 from ._kinematics import body_poses, body_velocities, constraint_rates, constraints, qdot_from_velocities
 from ._system import System, SystemParams
 

@@ -11,10 +11,9 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
+from .._core import is_concrete
 from ._dynamics import energy
 from ._errors import AssemblyError
-from ._projection import Inputs, _dependent, dynamics, input_values, projection, solve_s
-from .._core import is_concrete
 from ._forces import aux_names, aux_offsets
 from ._kinematics import (
     body_poses,
@@ -24,6 +23,7 @@ from ._kinematics import (
     marker_positions,
     qdot_from_velocities,
 )
+from ._projection import Inputs, _dependent, dynamics, input_values, projection, solve_s
 from ._system import System, SystemParams, checked_params
 
 #: Default gain (1/s) of the velocity-level drift stabilisation ``Phi_dot = -kappa Phi``.

@@ -22,11 +22,11 @@ p_dot...]``. Body velocities ``v = T y`` (eq. 5.49).
 import dataclasses
 
 import equinox as eqx
+import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
 from .._core import GRAVITY, ParameterError, check_range, float_field
-import jax.numpy as jnp
 from ._bodies import FlexibleBody, FlexOptions, RigidBody
 from ._rotations import SEQUENCES
 
@@ -471,9 +471,8 @@ def checked_params(system: System, params: SystemParams) -> SystemParams:
     joints = []
     for name, kind, joint in zip(system.joint_names, system.joint_kind, params.joints):
         if kind == "link":
-            joint = eqx.tree_at(
-                lambda j: j.length, joint, check_range(f"link {name!r} length (m)", joint.length, low=0.0, low_open=True)
-            )
+            length = check_range(f"link {name!r} length (m)", joint.length, low=0.0, low_open=True)
+            joint = eqx.tree_at(lambda j: j.length, joint, length)
         joints.append(joint)
     points = tuple(
         eqx.tree_at(lambda p: p.position, pt, check_range(f"point {name!r} position (m)", pt.position))

@@ -1,4 +1,4 @@
-"""Quarter car from the Appendix B hard points: kinematics (Figs. 6.11-6.12), projection-
+"""Vehicle corner (quarter car) from the Appendix B hard points: kinematics (Figs. 6.11-6.12), projection-
 matrix kinematic gradients (section 7.1.3) against finite differences of the assembled
 kinematics, gradients through assembly and simulation, and the dynamic residual bound."""
 
@@ -10,7 +10,7 @@ import pytest
 
 import jaxveh
 from jaxveh import multibody as mb
-from jaxveh.multibody import _examples as ex
+from jaxveh import vehicle
 from jaxveh.params import HARD_POINT_NAMES, load_vehicle_data
 
 #: Assembly converges quadratically; residual after 25 Newton steps is round-off.
@@ -28,17 +28,17 @@ RESIDUAL_BOUND = 1e-9
 
 @pytest.fixture(scope="module")
 def car():
-    return ex.quarter_car()
+    return vehicle.quarter_car()
 
 
 def _outputs(system, params, bump, rack):
-    _, out = ex.quarter_car_kinematics(system, params, bump, rack)
+    _, out = vehicle.quarter_car_kinematics(system, params, bump, rack)
     return jnp.stack([out["camber"], out["toe"], out["track"], out["wheel_centre"][0]])
 
 
 def test_kinematics_assemble_and_match_design(car):
     system, params = car
-    sweep = jax.jit(jax.vmap(lambda b: ex.quarter_car_kinematics(system, params, b, 0.0)[1]))
+    sweep = jax.jit(jax.vmap(lambda b: vehicle.quarter_car_kinematics(system, params, b, 0.0)[1]))
     out = sweep(jnp.linspace(-0.025, 0.025, 11))
     assert float(jnp.max(out["residual"])) < ASSEMBLY_RESIDUAL
     mid = 5
@@ -57,7 +57,7 @@ def _gradients_from_r(system, params, q, rack):
     bt = mb.velocity_matrix(system, params, q)
 
     def outputs(qq):
-        camber, toe = ex.wheel_angles(system, params, qq)
+        camber, toe = vehicle.wheel_angles(system, params, qq)
         return jnp.stack([camber, toe, 2.0 * qq[1], qq[0]])
 
     dq_ds = bt @ proj.R[:, 0]  # unit independent bump velocity (upright body uz)
@@ -71,7 +71,7 @@ def test_projection_gradients_match_finite_differences(car):
     kin = jax.jit(lambda b, r: _outputs(system, params, b, r))
     grads = jax.jit(lambda q, r: _gradients_from_r(system, params, q, r))
     for bump in (0.0, 0.015):
-        q, _ = ex.quarter_car_kinematics(system, params, bump, 0.0)
+        q, _ = vehicle.quarter_car_kinematics(system, params, bump, 0.0)
         d_bump, d_rack = grads(q, 0.0)
         fd = (kin(bump + FD_STEP, 0.0) - kin(bump - FD_STEP, 0.0)) / (2 * FD_STEP)
         np.testing.assert_allclose(d_bump, fd, atol=GRADIENT_ATOL)
@@ -85,12 +85,12 @@ def test_camber_gradient_with_respect_to_hard_points(car):
     """jax.grad through assembly (unrolled Newton) w.r.t. the upper ball joint H."""
     system, params = car
     hp = load_vehicle_data().hard_points_front.points
-    w = jnp.asarray([0.0, 0.63, ex.WHEEL_CENTRE_HEIGHT])
+    w = jnp.asarray([0.0, 0.63, vehicle.WHEEL_CENTRE_HEIGHT])
     k = HARD_POINT_NAMES.index("H")
 
     def camber_at_bump(hz):
-        p = ex.quarter_car_with_hard_points(system, params, hp.at[k, 2].set(hz), w)
-        return ex.quarter_car_kinematics(system, p, 0.02, 0.0, wheel_centre=w)[1]["camber"]
+        p = vehicle.quarter_car_with_hard_points(system, params, hp.at[k, 2].set(hz), w)
+        return vehicle.quarter_car_kinematics(system, p, 0.02, 0.0, wheel_centre=w)[1]["camber"]
 
     f = jax.jit(camber_at_bump)
     g = float(jax.jit(jax.grad(camber_at_bump))(hp[k, 2]))
@@ -103,7 +103,7 @@ def test_camber_gradient_with_respect_to_hard_points(car):
 def test_redundant_sixth_link_is_named():
     # rebuild the quarter car with the lower-rear link defined twice
     hp = load_vehicle_data().hard_points_front.points
-    w = np.array([0.0, 0.63, ex.WHEEL_CENTRE_HEIGHT])
+    w = np.array([0.0, 0.63, vehicle.WHEEL_CENTRE_HEIGHT])
     b = mb.SystemBuilder()
     b.add_rigid_body("upright", 14.0, np.eye(3) * 0.3, rotation="zxy")
     pts = {n: np.asarray(hp[HARD_POINT_NAMES.index(n)]) for n in ("A", "B", "C", "E", "F", "H", "L", "M")}
@@ -111,7 +111,7 @@ def test_redundant_sixth_link_is_named():
         b.add_point(n, "ground", pts[n])
     for n in ("C", "H", "M"):
         b.add_point(n, "upright", pts[n] - w)
-    for name, pa, pb in ex.QUARTER_CAR_LINKS + (("lower_rear_again", "A", "C"),):
+    for name, pa, pb in vehicle.QUARTER_CAR_LINKS + (("lower_rear_again", "A", "C"),):
         b.add_link(name, pa, pb, np.linalg.norm(pts[pa] - pts[pb]))
     b.add_independent("upright", "uz")  # 6 - 6 = 0 left: the build names the redundancy count
     with pytest.raises(ValueError, match="1 constraint equation\\(s\\) are redundant"):
@@ -121,8 +121,8 @@ def test_redundant_sixth_link_is_named():
 @pytest.fixture(scope="module")
 def drop_run(car):
     system, params = car
-    q0 = ex.quarter_car_design_q(system)
-    rate = ex.WheelRate(k=20000.0, c=0.0, z0=ex.WHEEL_CENTRE_HEIGHT, fz=14.0 * jaxveh.GRAVITY)
+    q0 = vehicle.quarter_car_design_q(system)
+    rate = vehicle.WheelRate(k=20000.0, c=0.0, z0=vehicle.WHEEL_CENTRE_HEIGHT, fz=14.0 * jaxveh.GRAVITY)
     inputs = lambda t: jnp.zeros((1,))  # noqa: E731
 
     def run(params, rate, bump0):
@@ -145,7 +145,7 @@ def test_quarter_car_bounce_residual_and_energy(car, drop_run):
     total = sim.energy + jax.vmap(rate.energy)(sim.q)
     assert float(jnp.max(jnp.abs(total - total[0]))) < 1e-6
     # it bounces: the wheel centre passes below its release height by several mm
-    assert float(jnp.min(sim.q[:, 2])) < ex.WHEEL_CENTRE_HEIGHT + 0.02 - 0.01
+    assert float(jnp.min(sim.q[:, 2])) < vehicle.WHEEL_CENTRE_HEIGHT + 0.02 - 0.01
     del system
 
 
@@ -155,12 +155,12 @@ def test_gradient_of_simulation_wrt_mass_and_hard_point(car, drop_run):
     system, _ = car
     run, params, rate = drop_run
     hp = load_vehicle_data().hard_points_front.points
-    w = jnp.asarray([0.0, 0.63, ex.WHEEL_CENTRE_HEIGHT])
+    w = jnp.asarray([0.0, 0.63, vehicle.WHEEL_CENTRE_HEIGHT])
     kc = HARD_POINT_NAMES.index("C")
 
     def final_height(x):
         mass, cz = x[0], x[1]
-        p = ex.quarter_car_with_hard_points(system, params, hp.at[kc, 2].set(cz), w)
+        p = vehicle.quarter_car_with_hard_points(system, params, hp.at[kc, 2].set(cz), w)
         p = eqx.tree_at(lambda s: s.bodies[0].mass, p, mass)
         return run(p, rate, jnp.asarray(0.02)).q[-1, 2]
 
@@ -176,12 +176,12 @@ def test_gradient_of_simulation_wrt_mass_and_hard_point(car, drop_run):
 def test_unreachable_travel_raises_naming_constraint_and_gap(car):
     system, params = car
     with pytest.raises(mb.AssemblyError, match=r"bump 400 mm.*constraint \w+\[length\] residual \(gap\) \d"):
-        ex.quarter_car_kinematics(system, params, 0.4, 0.0)
+        vehicle.quarter_car_kinematics(system, params, 0.4, 0.0)
 
 
 def test_unreachable_travel_in_jitted_sweep_is_flagged_and_finite(car):
     system, params = car
-    sweep = jax.jit(jax.vmap(lambda b: ex.quarter_car_kinematics(system, params, b, 0.0)[1]))
+    sweep = jax.jit(jax.vmap(lambda b: vehicle.quarter_car_kinematics(system, params, b, 0.0)[1]))
     out = sweep(jnp.asarray([0.0, 0.02, 0.4]))
     np.testing.assert_array_equal(np.asarray(out["ok"]), [True, True, False])
     for key in ("camber", "toe", "track", "wheel_centre", "residual"):
@@ -197,13 +197,13 @@ def test_halved_link_branch_jump_is_refused(car, link):
     k = system.joint_names.index(link)
     halved = eqx.tree_at(lambda p: p.joints[k].length, params, params.joints[k].length * 0.5)
     result = mb.solve_assembly(
-        system, halved, ex.quarter_car_design_q(system), (system.q_index("upright", "z"), 6),
+        system, halved, vehicle.quarter_car_design_q(system), (system.q_index("upright", "z"), 6),
         inputs=lambda t: jnp.zeros((1,)),
     )
     assert float(result.residual) < mb.ASSEMBLY_TOL  # Newton did converge ...
     assert not bool(result.ok)  # ... but on another branch
     with pytest.raises(mb.AssemblyError, match="jumped to another branch: a body rotated by"):
-        ex.quarter_car_kinematics(system, halved, 0.0, 0.0)
+        vehicle.quarter_car_kinematics(system, halved, 0.0, 0.0)
 
 
 def test_cli_inspect_unreachable_travel_fails_cleanly():

@@ -1,0 +1,35 @@
+"""The chapter-6 vehicle, built with :mod:`jaxveh.multibody` (today: one corner).
+
+``quarter_car`` builds the front-left (or rear-left) double-wishbone corner from the
+Appendix B hard points on a fixed chassis; ``quarter_car_kinematics`` sweeps it (camber,
+toe, track, wheel centre) and raises :class:`jaxveh.multibody.AssemblyError` for a travel
+that cannot be reached (or flags it in jitted sweeps).
+"""
+
+from ._corner import (
+    QUARTER_CAR_LINKS as QUARTER_CAR_LINKS,
+)
+from ._corner import (
+    WHEEL_CENTRE_HEIGHT as WHEEL_CENTRE_HEIGHT,
+)
+from ._corner import (
+    WheelRate as WheelRate,
+)
+from ._corner import (
+    quarter_car as quarter_car,
+)
+from ._corner import (
+    quarter_car_design_q as quarter_car_design_q,
+)
+from ._corner import (
+    quarter_car_kinematics as quarter_car_kinematics,
+)
+from ._corner import (
+    quarter_car_wheel_centre as quarter_car_wheel_centre,
+)
+from ._corner import (
+    quarter_car_with_hard_points as quarter_car_with_hard_points,
+)
+from ._corner import (
+    wheel_angles as wheel_angles,
+)
