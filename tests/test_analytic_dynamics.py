@@ -6,6 +6,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers import central_difference
+from jax.test_util import check_grads
 
 from jaxveh.analytic import (
     FLEXIBLE,
@@ -48,6 +49,7 @@ def test_root_finding_equals_end_of_long_integration(vehicle, name):
     assert abs(float(end[PF])) < 1e-8 and abs(float(end[PR])) < 1e-8
 
 
+@pytest.mark.slow
 def test_small_ay_slope_equals_linear_understeer_gradient(vehicle):
     # At small ay load transfer is second order: the slope of δ is ku of (3.11) / (3.16).
     ay = 0.01 * GRAVITY
@@ -57,6 +59,7 @@ def test_small_ay_slope_equals_linear_understeer_gradient(vehicle):
         assert float(state.delta_dynamic[0] / ay) == pytest.approx(float(ku(vehicle)), rel=2e-3)
 
 
+@pytest.mark.slow
 def test_above_grip_limit_is_reported(vehicle):
     state, sens = skidpad_sweep(vehicle, jnp.asarray([0.5, 3.0]) * GRAVITY, FLEXIBLE)
     assert bool(state.converged[0]) and not bool(state.converged[1])
@@ -65,6 +68,7 @@ def test_above_grip_limit_is_reported(vehicle):
         skidpad_steady_state(vehicle, 3.0 * GRAVITY, FLEXIBLE, throw=True).delta.block_until_ready()
 
 
+@pytest.mark.slow
 def test_implicit_gradient_of_steer_angle(vehicle):
     def delta(x):
         v = eqx.tree_at(lambda veh: (veh.kC, veh.kF), vehicle, (x[0], x[1]))
@@ -76,6 +80,19 @@ def test_implicit_gradient_of_steer_angle(vehicle):
     np.testing.assert_allclose(g, fd, rtol=1e-5)
 
 
+def test_check_grads_of_skidpad_trim(vehicle):
+    """Implicit-function derivatives of the trim, forward and reverse mode, in ay (m/s^2) and
+    kC (scaled by 1e4 Nm/rad so one finite-difference step suits both)."""
+
+    def trim(x):
+        v = eqx.tree_at(lambda veh: veh.kC, vehicle, 1e4 * x[1])
+        state = skidpad_steady_state(v, x[0], FLEXIBLE)
+        return jnp.stack([state.delta, state.phi_front - state.phi_rear])
+
+    check_grads(jax.jit(trim), (jnp.asarray([6.0, 2.2]),), order=1, modes=("fwd", "rev"), eps=1e-4, rtol=1e-5)
+
+
+@pytest.mark.slow
 def test_sweep_sensitivity_equals_finite_difference_of_curve(vehicle):
     ays = jnp.asarray([1.0, 1.0 + 1e-4, 1.0 - 1e-4]) * GRAVITY
     state, sens = skidpad_sweep(vehicle, ays, FLEXIBLE)

@@ -5,6 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import scipy.signal
+from jax.test_util import check_grads
 
 from jaxveh.analytic import (
     RIGID,
@@ -111,3 +112,18 @@ def test_frequency_response_against_scipy(vehicle):
 def test_eigenvalues_stable_over_speed(vehicle):
     for speed in SPEEDS:
         assert np.all(np.asarray(eigenvalues(vehicle, speed)).real < 0)
+
+
+def test_check_grads_of_linear_model_in_speed_and_stiffness(vehicle):
+    """A of (3.37) and the static yaw gain, in u and kC, forward and reverse mode."""
+
+    def a_matrix(x):
+        v = with_distribution(vehicle, mu=x[1])
+        return state_space(v, x[0])[0]
+
+    check_grads(a_matrix, (jnp.asarray([15.0, 1.2]),), order=2, modes=("fwd", "rev"), eps=1e-5)
+
+    def yaw_gain(x):
+        return frequency_response(with_distribution(vehicle, mu=x[1]), x[0], [0.0])["yaw_rate"][0].real
+
+    check_grads(yaw_gain, (jnp.asarray([20.0, 0.8]),), order=1, modes=("fwd", "rev"), eps=1e-5)

@@ -5,6 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers import central_difference
+from jax.test_util import check_grads
 
 from jaxveh.analytic import (
     chi,
@@ -121,3 +122,15 @@ def test_new_parameter_values_do_not_retrace(vehicle):
     summary(vehicle)
     summary(with_distribution(vehicle, lam=0.3, mu=2.0))
     summary(with_distribution(vehicle, lam=0.7))
+
+
+def test_check_grads_of_chi_in_lambda_and_mu(vehicle):
+    """Forward and reverse mode, first and second order, against JAX's finite differences."""
+
+    def chi_of(x):
+        return chi(with_distribution(vehicle, lam=x[0], mu=x[1]))
+
+    check_grads(chi_of, (jnp.asarray([0.45, 0.8]),), order=2, modes=("fwd", "rev"), eps=1e-5)
+    # and of the sensitivity χλ (itself a jax.grad) in µ: a third derivative of χ overall.
+    check_grads(lambda m: chi_sensitivity(with_distribution(vehicle, mu=m)), (jnp.asarray(2.0),), order=1,
+                modes=("fwd", "rev"), eps=1e-5)

@@ -1,9 +1,11 @@
 """Roll steer and understeer gradient (section 3.2)."""
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers import central_difference
+from jax.test_util import check_grads
 
 from jaxveh.analytic import (
     RAD_PER_MS2_TO_DEG_PER_G,
@@ -71,3 +73,10 @@ def test_understeer_gradient_wrt_stiffness_and_lambda(vehicle):
     g = np.asarray(jax.grad(ku)(jax.numpy.asarray(x0)))
     fd = central_difference(ku, x0, 1e-6)
     np.testing.assert_allclose(g, fd, rtol=1e-6)
+
+
+def test_check_grads_of_understeer_gradient(vehicle):
+    def ku(x):
+        return understeer_gradient(with_distribution(vehicle, lam=x[0], mu=x[1]))
+
+    check_grads(ku, (jnp.asarray([0.55, 1.3]),), order=2, modes=("fwd", "rev"), eps=1e-5)

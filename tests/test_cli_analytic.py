@@ -3,6 +3,7 @@
 import json
 
 import pytest
+import typer.main
 from typer.testing import CliRunner
 
 from jaxveh.cli import app
@@ -82,3 +83,18 @@ def test_preview_contract():
     assert 0 < out["preview_distance_m"] <= 200 * step
     assert out["preview_distance_m"] / step == pytest.approx(round(out["preview_distance_m"] / step), abs=1e-9)
     assert out["riccati_residual"] < 1e-9
+
+
+@pytest.mark.parametrize("group", ["analytic", "tyre", "chassis", "multibody", "run"])
+def test_json_option_is_bound_to_as_json(group):
+    """`--json` is one parameter name everywhere (`as_json`), never `json` or `json_out`."""
+    root = typer.main.get_command(app)
+    command = root.commands[group]
+    commands = list(command.commands.items()) if hasattr(command, "commands") else [(group, command)]
+    checked = 0
+    for name, cmd in commands:
+        for param in cmd.params:
+            if "--json" in getattr(param, "opts", []):
+                assert param.name == "as_json", f"{group} {name}: --json is bound to {param.name!r}"
+                checked += 1
+    assert checked >= 1

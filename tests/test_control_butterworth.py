@@ -5,6 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import scipy.signal
+from jax.test_util import check_grads
 
 from jaxveh.control import butterworth_lowpass
 
@@ -63,6 +64,14 @@ def test_gradient_wrt_cutoff_matches_finite_differences():
     fc, h = 2.0, 1e-6
     fd = (impulse_energy(fc + h) - impulse_energy(fc - h)) / (2 * h)
     np.testing.assert_allclose(jax.grad(impulse_energy)(jnp.asarray(fc)), fd, rtol=FD_RTOL)
+
+
+def test_check_grads_wrt_cutoff_and_sample_time():
+    def matrices(x):
+        f = butterworth_lowpass(4, x[0], x[1])
+        return jnp.concatenate([f.a.ravel(), f.b.ravel(), f.c.ravel(), f.d.ravel()])
+
+    check_grads(jax.jit(matrices), (jnp.asarray([2.0, 0.01]),), order=2, modes=("fwd", "rev"), eps=1e-6)
 
 
 def test_bad_order_and_cutoff_raise():

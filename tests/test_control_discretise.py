@@ -7,6 +7,7 @@ import pytest
 import scipy.linalg
 import scipy.signal
 from helpers import assert_grad_matches_fd
+from jax.test_util import check_grads
 
 from jaxveh.control import zoh
 
@@ -49,6 +50,16 @@ def test_zoh_gradient_matches_finite_differences():
         return jnp.sum(a_d**2) + jnp.sum(jnp.sin(b_d))
 
     assert_grad_matches_fd(f, np.array([a_c[1, 3], 0.05]), h=1e-6, rtol=1e-6)
+
+
+def test_check_grads_of_zoh():
+    a_c, b_c = _random_system(3)
+
+    def discrete(x):
+        a_d, b_d = zoh(jnp.asarray(a_c) * x[0], jnp.asarray(b_c), x[1])
+        return jnp.concatenate([a_d.ravel(), b_d.ravel()])
+
+    check_grads(jax.jit(discrete), (jnp.asarray([0.8, 0.05]),), order=1, modes=("fwd", "rev"), eps=1e-5)
 
 
 def test_zoh_rejects_bad_shapes():

@@ -139,6 +139,7 @@ def test_preview_distance_closed_forms():
         preview_distance(jnp.zeros(10), u, DT)
 
 
+@pytest.mark.slow
 def test_gradients_match_finite_differences():
     """d/d(front cornering stiffness) of the interpolated Lp and of sum Kp^2.
 

@@ -6,6 +6,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import scipy.linalg
+from jax.test_util import check_grads
 
 from jaxveh.control import RESULTS, riccati_residual, solve_dare, zoh
 
@@ -90,6 +91,17 @@ def test_vmap_and_vmap_of_grad():
     for i, s in enumerate(np.asarray(scales)):
         fd = (trace_p(s + FD_STEP) - trace_p(s - FD_STEP)) / (2 * FD_STEP)
         np.testing.assert_allclose(grads[i], fd, rtol=FD_RTOL)
+
+
+def test_check_grads_of_riccati_solution():
+    """First-order derivatives of P and K (implicit function theorem) in both modes."""
+    a, b, q, r = _random_problem(5, n=4, m=1)
+
+    def solution(x):
+        sol = solve_dare(jnp.asarray(a) * x[0], jnp.asarray(b), jnp.asarray(q) * x[1], jnp.asarray(r) * x[2])
+        return jnp.concatenate([sol.p.ravel(), sol.k.ravel()])
+
+    check_grads(jax.jit(solution), (jnp.asarray([0.9, 1.0, 1.5]),), order=1, modes=("fwd", "rev"), eps=1e-6, rtol=1e-5)
 
 
 def test_unstabilisable_system_is_reported():

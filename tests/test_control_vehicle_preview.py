@@ -26,6 +26,7 @@ def _gains(vehicle, mu, rigid):
     return preview_controller(a_c, b_c, jnp.zeros(a_c.shape[0]).at[0].set(1.0))
 
 
+@pytest.mark.slow
 def test_flexible_tends_to_rigid_and_compliance_lengthens_preview(vehicle):
     rigid = _gains(vehicle, 1.0, True)
     stiff, soft = jax.vmap(lambda mu: _gains(vehicle, mu, False).preview)(jnp.array([1e4, 0.1]))

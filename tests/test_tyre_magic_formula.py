@@ -10,6 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers import central_difference
+from jax.test_util import check_grads
 
 import jaxveh.tyre as jt
 from jaxveh.params import as_float
@@ -205,6 +206,15 @@ def test_gradient_wrt_slips_matches_finite_differences():
     g = jax.grad(scalar)(jnp.asarray(x0))
     fd = central_difference(scalar, x0, 1e-6)
     np.testing.assert_allclose(g, fd, rtol=FD_RTOL, atol=1e-6)
+
+
+def test_check_grads_wrt_operating_point():
+    """All five outputs in load (kN), slips and camber, forward and reverse mode."""
+
+    def outputs(x):
+        return jnp.stack(jt.tyre_forces(FIXTURE, 1e3 * x[0], x[1], x[2], x[3], 20.0))
+
+    check_grads(outputs, (jnp.asarray([3.5, 0.06, 0.07, 0.03]),), order=1, modes=("fwd", "rev"), eps=1e-6, rtol=1e-5)
 
 
 def test_gradient_wrt_every_coefficient_matches_finite_differences():

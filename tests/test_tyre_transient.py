@@ -9,6 +9,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers import assert_grad_matches_fd
+from jax.test_util import check_grads
 
 import jaxveh.tyre as jt
 
@@ -68,6 +69,18 @@ def test_transient_rhs_gradient_wrt_relaxation_length():
         return jnp.sum(jt.transient_slip_rhs(t, jnp.asarray([0.02, -0.01]), 600.0, 0.0, 10.0, 0.3, 0.4) ** 2)
 
     assert_grad_matches_fd(f, np.array([0.3, 0.25]), h=1e-7, rtol=1e-6)
+
+
+def test_check_grads_of_transient_slip_model():
+    """Deflection rates in deflections, speed and relaxation lengths; MF 5.2 lengths in load."""
+
+    def rhs(x):
+        t = eqx.tree_at(lambda t: (t.sigma_kappa, t.sigma_alpha), FSAE, (x[3], x[4]))
+        return jt.transient_slip_rhs(t, x[:2], 600.0, 0.0, x[2], 0.3, 0.4)
+
+    check_grads(rhs, (jnp.asarray([0.02, -0.01, 10.0, 0.3, 0.25]),), order=2, modes=("fwd", "rev"), eps=1e-6)
+    check_grads(lambda fz: jnp.stack(jt.relaxation_lengths(FIXTURE, 1e3 * fz, 0.02)), (jnp.asarray(3.0),), order=2,
+                modes=("fwd", "rev"), eps=1e-5)
 
 
 def test_steady_slips_low_speed_treatment():

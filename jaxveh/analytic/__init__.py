@@ -6,8 +6,6 @@ Every function here that takes an :class:`~jaxveh.params.AnalyticVehicle` checks
 traced ones), and a ``speed`` argument > 0; see "Input validation" in ``docs/analytic.md``.
 """
 
-# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
-# ruff: noqa: I001
 from . import _linear, _load_transfer, _model, _modes, _quantities, _roll_steer, _steady, _transient, _tyre
 from ._checks import tyre_checked as _tyre_checked, vehicle_checked as _vehicle_checked
 from ._inputs import AbstractSteer as AbstractSteer, ConstantSteer as ConstantSteer, SmoothStep as SmoothStep

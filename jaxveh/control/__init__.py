@@ -5,8 +5,6 @@ Generic: nothing here knows about vehicles. A vehicle model supplies continuous-
 ``(a_c, b_c)`` and the output row selecting the lateral position.
 """
 
-# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
-# ruff: noqa: I001
 from ._butterworth import (
     DiscreteStateSpace as DiscreteStateSpace,
     butterworth_lowpass as butterworth_lowpass,

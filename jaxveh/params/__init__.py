@@ -1,7 +1,5 @@
 """Vehicle parameters: Equinox pytrees in SI units, loaded from TOML data files."""
 
-# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
-# ruff: noqa: I001
 from .._core import as_float as as_float, float_field as float_field
 from ._appendix_a import (
     TYRE_RANGES as TYRE_RANGES,

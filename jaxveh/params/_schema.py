@@ -10,8 +10,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from .._core import ParameterError as ParameterError
-from .._core import read_toml as read_toml
+from .._core import ParameterError as ParameterError, read_toml as read_toml
 
 #: Factor that converts a value written in the unit to SI.
 UNIT_TO_SI: dict[str, float] = {

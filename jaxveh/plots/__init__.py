@@ -1,7 +1,5 @@
 """Matplotlib figures in the style of the thesis (Agg backend, PNG output)."""
 
-# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
-# ruff: noqa: I001
 from ._chapter3 import (
     figure as figure,
     plot_bode as plot_bode,

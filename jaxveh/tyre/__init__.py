@@ -6,10 +6,7 @@ tyre check its coefficients first (:func:`check_tyre`); see "Input validation" i
 ``docs/tyre.md``.
 """
 
-# Re-exports grouped per module, as in equinox (ruff's isort would split every `as` import).
-# ruff: noqa: I001
 from . import _magic_formula, _transient, _vertical
-
 from ._axes import (
     forces_to_vehicle as forces_to_vehicle,
     inclination_angle as inclination_angle,
