@@ -206,3 +206,18 @@ def test_point_kinematics(random_body):
     assert body.point_index("b") == 1
     with pytest.raises(ParameterError, match="modal body has no point 'c'; known points: \\['a', 'b'\\]"):
         body.point_index("c")
+
+
+def test_neglect_c_keeps_the_undeformed_centre_of_mass(random_body):
+    """Thesis Table 7.2 option: the centre of mass c0 instead of c(p) in M(p) and h_g."""
+    body, _ = random_body
+    p, g = jnp.asarray([0.1, -0.2, 0.3]), jnp.asarray([0.0, 0.0, -9.81])
+    m = body.invariants.mass
+    full, fixed = body.mass_matrix(p), body.mass_matrix(p, neglect_c=True)
+    np.testing.assert_allclose(fixed[3:6, :3], m * fe.skew(body.invariants.c0), rtol=RTOL_EXACT)
+    np.testing.assert_allclose(fixed[6:, :], full[6:, :], rtol=RTOL_EXACT)
+    np.testing.assert_allclose(fixed[3:6, 3:], full[3:6, 3:], rtol=RTOL_EXACT)
+    hg = body.gravity_forces(p, g, neglect_c=True)
+    np.testing.assert_allclose(hg[3:6], m * jnp.cross(body.invariants.c0, g), rtol=RTOL_EXACT)
+    p0 = jnp.zeros(3)
+    np.testing.assert_allclose(body.gravity_forces(p0, g, neglect_c=True), body.gravity_forces(p0, g))

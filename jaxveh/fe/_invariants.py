@@ -354,10 +354,11 @@ class ModalBody(eqx.Module):
         """Rotation-elastic coupling ``Cr = Cr0 + Σ_l C5_l p_l`` (kg m)."""
         return self.invariants.Cr0 + jnp.einsum("lim,l->im", self.invariants.C5, p)
 
-    def mass_matrix(self, p: Float[Array, " N"]) -> Float[Array, "6+N 6+N"]:
-        """Mass matrix of eq. 5.37 for velocities ``[v, ω, ṗ]`` (body frame)."""
+    def mass_matrix(self, p: Float[Array, " N"], neglect_c: bool = False) -> Float[Array, "6+N 6+N"]:
+        """Mass matrix of eq. 5.37 for velocities ``[v, ω, ṗ]`` (body frame); ``neglect_c``
+        (static, thesis Table 7.2) drops the deformation shift of the centre of mass."""
         inv = self.invariants
-        mct = inv.mass * skew(self.com(p))
+        mct = inv.mass * skew(inv.c0 if neglect_c else self.com(p))
         cr = self.Cr(p)
         top = jnp.concatenate([inv.mass * jnp.eye(3), -mct, inv.Ct], axis=1)
         mid = jnp.concatenate([mct, self.inertia(p), cr], axis=1)
@@ -407,10 +408,14 @@ class ModalBody(eqx.Module):
         he = inv.Ct.T @ (wt @ v) + jnp.einsum("l,ljk,k->j", pd, self.Ge(), omega) + self.Oe(omega)
         return -jnp.concatenate([ht, hr, he])
 
-    def gravity_forces(self, p: Float[Array, " N"], g: Float[Array, "3"]) -> Float[Array, " 6+N"]:
-        """Gravity ``h_g = [m g; m c̃ g; Ctᵀ g]`` (eq. 5.43); ``g`` in body axes (m/s²)."""
+    def gravity_forces(
+        self, p: Float[Array, " N"], g: Float[Array, "3"], neglect_c: bool = False
+    ) -> Float[Array, " 6+N"]:
+        """Gravity ``h_g = [m g; m c̃ g; Ctᵀ g]`` (eq. 5.43); ``g`` in body axes (m/s²);
+        ``neglect_c`` as in :meth:`mass_matrix`."""
         inv = self.invariants
-        return jnp.concatenate([inv.mass * g, inv.mass * (skew(self.com(p)) @ g), inv.Ct.T @ g])
+        c = inv.c0 if neglect_c else self.com(p)
+        return jnp.concatenate([inv.mass * g, inv.mass * jnp.cross(c, g), inv.Ct.T @ g])
 
     # --- kinematics of named points ----------------------------------------------------
     def point_displacement(self, p: Float[Array, " N"]) -> Float[Array, "P 3"]:
