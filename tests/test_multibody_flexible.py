@@ -49,14 +49,16 @@ def test_free_free_vibration_at_fe_frequency(beam):
     """Floating beam, no gravity: mode 0 released from p0 oscillates at the FE frequency."""
     system, params = ex.flexible_pendulum(beam, pinned=False, gravity=0.0)
     f0 = float(beam.frequencies_hz[0])
-    p0 = 1e-3
+    # small amplitude: with the tube's tiny polar inertia (8e-6 kg m^2, nodal rotary inertia)
+    # the first-order mass matrix of eq. 5.37 stops being usable near p ~ 3e-4 (see docs)
+    p0 = 1e-4
     q0 = jnp.concatenate([jnp.zeros(6), jnp.asarray([p0, 0.0])])
     z0 = jnp.zeros(system.n_dof)
     ts = jnp.linspace(0.0, 3.0 / f0, 61)
     sim = jax.jit(lambda p: mb.simulate(system, p, q0, z0, 0.0, 3.0 / f0, ts=ts, rtol=1e-10, atol=1e-13))(params)
     expected = p0 * np.cos(2 * np.pi * f0 * np.asarray(ts))
-    # nonlinear (first-order-in-p) inertia coupling at p0 = 1e-3 is ~1e-6 relative
-    np.testing.assert_allclose(np.asarray(sim.q[:, 6]), expected, atol=1e-8)
+    # nonlinear (first-order-in-p) inertia coupling at p0 = 1e-4 is ~1e-7 relative
+    np.testing.assert_allclose(np.asarray(sim.q[:, 6]), expected, atol=1e-10)
     np.testing.assert_allclose(np.asarray(sim.q[:, :6]), 0.0, atol=1e-9)  # mean-axis modes: frame at rest
 
 

@@ -5,13 +5,14 @@ Velocities of a body are expressed in its own moving frame: ``v = [u, omega, p_d
 body axes (eq. 5.31), and ``p_dot`` the modal velocities of a flexible body.
 """
 
+import abc
 from typing import Any
 
 import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ..params import float_field
+from .._core import float_field
 from ._rotations import skew
 
 
@@ -29,7 +30,37 @@ class FlexOptions(eqx.Module):
     neglect_c: bool = eqx.field(static=True, default=False)
 
 
-class RigidBody(eqx.Module):
+class AbstractBody(eqx.Module):
+    """A body of the library: its mass matrix in body-frame velocities ``[u, omega, p_dot]``,
+    gravity, elastic forces and potential energies (what eqs. 5.25-5.45 need of it)."""
+
+    @property
+    @abc.abstractmethod
+    def n_modes(self) -> int:
+        """Number of modal coordinates (0 for a rigid body)."""
+
+    @abc.abstractmethod
+    def mass_matrix(self, p, options: FlexOptions):
+        """Body mass matrix (6 + n_modes square) at modal coordinates ``p``."""
+
+    @abc.abstractmethod
+    def gravity(self, g_body, p, options: FlexOptions):
+        """Generalised gravity force for gravity ``g_body`` in body axes (m/s^2)."""
+
+    @abc.abstractmethod
+    def elastic(self, p, p_dot):
+        """Elastic and damping generalised forces on the modal coordinates."""
+
+    @abc.abstractmethod
+    def potential_gravity(self, r, a, p, g):
+        """Gravitational potential energy (J) at origin ``r``, rotation ``a``."""
+
+    @abc.abstractmethod
+    def potential_elastic(self, p):
+        """Strain energy (J)."""
+
+
+class RigidBody(AbstractBody):
     """A rigid body: mass (kg), inertia tensor about its c.g. in body axes (kg m^2, products
     of inertia included), and the c.g. position in the body frame (m; zero for a centroidal
     reference point, the thesis's usual choice)."""
@@ -71,7 +102,7 @@ class RigidBody(eqx.Module):
         return jnp.zeros((), p.dtype)
 
 
-class FlexibleBody(eqx.Module):
+class FlexibleBody(AbstractBody):
     """A flexible body in a floating frame with modal coordinates ``p`` (section 5.4.2).
 
     ``modal`` is a modal body from the FE module (:class:`jaxveh.fe.ModalBody`: invariants
@@ -89,18 +120,10 @@ class FlexibleBody(eqx.Module):
         return self.modal.n_modes
 
     def mass_matrix(self, p, options: FlexOptions) -> Float[Array, "6+nm 6+nm"]:
-        """Mass matrix of eq. (5.37) at modal coordinates ``p`` (first order in ``p``)."""
-        inv = self.modal.invariants
-        if options.constant_mass:
-            p = jnp.zeros_like(p)
-        m = inv.mass
-        c = inv.c0 if options.neglect_c else inv.c0 + (inv.Ct @ p) / m
-        ct = skew(c)
-        c4 = jnp.einsum("lij,l->ij", inv.C4, p)
-        j = inv.J0 - (c4 + c4.T)
-        cr = inv.Cr0 + jnp.einsum("lij,l->ij", inv.C5, p)
-        eye = jnp.eye(3, dtype=m.dtype)
-        return jnp.block([[m * eye, -m * ct, inv.Ct], [m * ct, j, cr], [inv.Ct.T, cr.T, inv.Me]])
+        """Mass matrix of eq. (5.37) at modal coordinates ``p`` (first order in ``p``), from
+        the FE module's one implementation of the invariants' formulas."""
+        p = jnp.zeros_like(p) if options.constant_mass else p
+        return self.modal.mass_matrix(p, neglect_c=options.neglect_c)
 
     def _com_moment(self, p):
         """``m c(p) = m c0 + Ct p`` (kg m, body axes)."""
@@ -109,9 +132,7 @@ class FlexibleBody(eqx.Module):
 
     def gravity(self, g_body, p, options: FlexOptions):
         """Generalised gravity force of eq. (5.43) with ``g_body`` in body axes (m/s^2)."""
-        inv = self.modal.invariants
-        mc = inv.mass * inv.c0 if options.neglect_c else self._com_moment(p)
-        return jnp.concatenate([inv.mass * g_body, jnp.cross(mc, g_body), inv.Ct.T @ g_body])
+        return self.modal.gravity_forces(p, g_body, neglect_c=options.neglect_c)
 
     def elastic(self, p, p_dot):
         """Elastic and damping generalised forces ``-(K p + D p_dot)`` (eq. 5.44)."""
