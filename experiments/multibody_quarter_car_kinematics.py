@@ -23,8 +23,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxveh  # noqa: E402,F401  (float64)
-from jaxveh import multibody as mb  # noqa: E402
-from jaxveh import vehicle
+from jaxveh import (
+    multibody as mb,  # noqa: E402
+    vehicle,
+)
 
 DEG = 180.0 / np.pi
 

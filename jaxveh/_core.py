@@ -6,7 +6,6 @@ solutions and modal reductions need double precision. Library entry points call
 :func:`check_x64`, which raises if a user switched it off afterwards.
 """
 
-import tomllib
 from importlib import resources
 from pathlib import Path
 
@@ -14,6 +13,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+import tomllib
 
 jax.config.update("jax_enable_x64", True)
 

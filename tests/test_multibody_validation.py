@@ -8,8 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxveh import ParameterError, vehicle
-from jaxveh import multibody as mb
+from jaxveh import ParameterError, multibody as mb, vehicle
 from jaxveh.multibody import _examples as ex
 
 

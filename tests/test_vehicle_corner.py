@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 import jaxveh
-from jaxveh import multibody as mb
-from jaxveh import vehicle
+from jaxveh import multibody as mb, vehicle
 from jaxveh.params import HARD_POINT_NAMES, load_vehicle_data
 
 #: Assembly converges quadratically; residual after 25 Newton steps is round-off.

@@ -8,28 +8,12 @@ that cannot be reached (or flags it in jitted sweeps).
 
 from ._corner import (
     QUARTER_CAR_LINKS as QUARTER_CAR_LINKS,
-)
-from ._corner import (
     WHEEL_CENTRE_HEIGHT as WHEEL_CENTRE_HEIGHT,
-)
-from ._corner import (
     WheelRate as WheelRate,
-)
-from ._corner import (
     quarter_car as quarter_car,
-)
-from ._corner import (
     quarter_car_design_q as quarter_car_design_q,
-)
-from ._corner import (
     quarter_car_kinematics as quarter_car_kinematics,
-)
-from ._corner import (
     quarter_car_wheel_centre as quarter_car_wheel_centre,
-)
-from ._corner import (
     quarter_car_with_hard_points as quarter_car_with_hard_points,
-)
-from ._corner import (
     wheel_angles as wheel_angles,
 )
