@@ -107,8 +107,9 @@ class FlexibleBody(AbstractBody):
 
     ``modal`` is a modal body from the FE module (:class:`jaxveh.fe.ModalBody`: invariants
     ``mass, c0, J0, Ct, Cr0, C4, C5, Me`` of eqs. 5.38-5.42 in body axes, modal stiffness
-    with its per-mode multiplier ``stiffness_scale``, damping ``alpha Me + beta K``, mode
-    shapes at named points). ``coupling`` (0..1) scales the mode shapes at the body's points
+    with its per-mode multiplier ``stiffness_scale``, damping ``alpha Me + beta K +
+    diag(2 zeta_i omega_i)`` with modal damping ratios ``zeta`` (default 0.025, thesis
+    section 7.3), mode shapes at named points). ``coupling`` (0..1) scales the mode shapes at the body's points
     (thesis Fig. 7.7). The mass matrix is assembled here from the invariants (eq. 5.37).
     """
 

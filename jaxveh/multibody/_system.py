@@ -287,8 +287,8 @@ class SystemBuilder:
         shapes at its points. Add its points with :meth:`add_modal_point`."""
         if not float(modal.mass) > 0.0:
             raise ParameterError(f"body {name!r}: mass must be > 0")
-        if np.any(np.asarray(modal.stiffness_scale) < 0.0):
-            raise ParameterError(f"body {name!r}: stiffness_scale must be >= 0")
+        if not np.all(np.asarray(modal.stiffness_scale) > 0.0):
+            raise ParameterError(f"body {name!r}: stiffness_scale must be > 0 (a multiplier of every modal stiffness)")
         if not 0.0 <= float(coupling) <= 1.0:
             raise ParameterError(f"body {name!r}: coupling = {float(coupling):g} must be in [0, 1]")
         self._add_body(name, FlexibleBody(modal=modal, coupling=coupling), parent, rotation, revolute)
