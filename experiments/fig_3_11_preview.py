@@ -99,9 +99,10 @@ def run(out: Path, n_mu: int, vehicle_path: str | None) -> dict:
     return report
 
 
-def compute(vehicle, n_mu: int, out: Path | None = None) -> tuple[dict, tuple]:
+def compute(vehicle, n_mu: int, out: Path | None = None, extras: bool = True) -> tuple[dict, tuple]:
     """The report and the panel data ``(panels_gains, panels_lp, mu_grid)`` of :func:`figure`;
-    CSV files of the curves go into ``out`` when given."""
+    CSV files of the curves go into ``out`` when given. ``extras=False`` skips the minimum-µ
+    bisection and dLp/dµ (NaN in the report), which the figure does not need."""
     mu_grid = np.geomspace(*MU_RANGE, n_mu)
     report = {"thesis": THESIS, "settings": {"dt_s": DT, "n_preview": N_PREVIEW, "q_weight": 1000.0,
                                              "r_weight": 1.0, "filter": "Butterworth 4th order, 2 Hz",
@@ -126,11 +127,11 @@ def compute(vehicle, n_mu: int, out: Path | None = None) -> tuple[dict, tuple]:
         sweep_s = time.perf_counter() - t0
         asymptote, asymptote_interp = curves["lp_rigid_m"], curves["lp_rigid_interp_m"]
         single = jax.jit(lambda mu, s=speed: lp_of_mu(vehicle, s, mu)[1])
-        mu_min, how = minimum_mu(single, asymptote_interp, mu_grid, lp[:, 1])
+        mu_min, how = minimum_mu(single, asymptote_interp, mu_grid, lp[:, 1]) if extras else (float("nan"), "skipped")
         excess_step = lp[:, 0] / asymptote - 1.0
         bad = np.nonzero(excess_step > THRESHOLD)[0]
         mu_min_step = float(mu_grid[bad[-1] + 1]) if bad.size else float(mu_grid[0])
-        dlp_dmu = float(jax.grad(lambda mu, s=speed: lp_of_mu(vehicle, s, mu)[1])(jnp.asarray(MU_GAINS)))
+        dlp_dmu = float(jax.grad(single)(jnp.asarray(MU_GAINS))) if extras else float("nan")
         panels_lp[kmh] = (lp, asymptote, asymptote_interp)
         report[f"{kmh:g}_kmh"] = {
             "lp_rigid_m": asymptote,

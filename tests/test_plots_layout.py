@@ -160,5 +160,5 @@ def test_experiment_figures(vehicle, experiments, tmp_path):
     _assert_clean(fig_3_4_understeer.figure(fig_3_4_understeer.compute(vehicle, n=21, n_map=11)),
                   tmp_path, "fig_3_4")
     _assert_clean(fig_3_9_root_locus.figure(vehicle, fig_3_9_root_locus.compute(vehicle, n=12)), tmp_path, "fig_3_9")
-    _, panels = fig_3_11_preview.compute(vehicle, n_mu=3)
+    _, panels = fig_3_11_preview.compute(vehicle, n_mu=3, extras=False)
     _assert_clean(fig_3_11_preview.figure(*panels), tmp_path, "fig_3_11")
