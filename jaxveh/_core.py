@@ -70,6 +70,8 @@ def check_range(name: str, value, *, low=None, high=None, low_open=False, high_o
     if is_concrete(bad):  # inside jit even constants give traced results
         bad_np = np.asarray(bad)
         if bad_np.any():
+            if not is_concrete(value):  # e.g. under an un-jitted jax.grad: the flag is known, the value traced
+                raise ParameterError(message)
             shown = np.asarray(value)[bad_np].ravel()[:3]
             raise ParameterError(f"{message}; got {', '.join(f'{v:g}' for v in shown)}")
         return value

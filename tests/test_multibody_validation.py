@@ -61,3 +61,14 @@ def test_traced_bad_value_fails_at_run_time(pendulum):
     assert np.isfinite(float(final_angle(jnp.asarray(2.0))))
     with pytest.raises(Exception, match=r"body 'B1' mass \(kg\) must lie in \[0, inf\)"):
         final_angle(jnp.asarray(-2.0)).block_until_ready()
+
+
+def test_check_range_under_grad_and_jit_names_the_field():
+    """Concrete flags with traced values (un-jitted grad) and concrete values inside jit."""
+    from jaxveh._core import check_range
+
+    with pytest.raises(ParameterError, match=r"^mass \(kg\) must lie in \[0, inf\)\n"):
+        jax.grad(lambda m: check_range("mass (kg)", m, low=0.0))(-1.0)
+    with pytest.raises(Exception, match=r"mass \(kg\) must lie in \[0, inf\)"):
+        jax.jit(lambda x: x + check_range("mass (kg)", jnp.asarray(-1.0), low=0.0))(1.0).block_until_ready()
+    assert float(jax.grad(lambda m: check_range("mass (kg)", m, low=0.0) ** 2)(3.0)) == 6.0
