@@ -10,16 +10,19 @@ option from the full model. Prints a table and writes JSON.
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 import jaxveh  # noqa: F401  (float64)
 from jaxveh import multibody as mb
 from jaxveh.multibody import _examples as ex
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _vehicle_topology import assembly_fixed, vehicle_scale_system  # noqa: E402
 
 BATCH = 64
 
@@ -53,50 +56,6 @@ def cases():
     yield "vehicle topology (9 bodies, 6 modes)", s, p, q, z, rack
 
 
-def vehicle_scale_system():
-    """A system with the 14-DOF vehicle's topology (section 6.1): FE chassis (6 modes) as a
-    free modal body, four uprights on five links each (Table 6.3) with the Appendix B hard
-    points, four wheels on tree revolute joints, a rack input moving both front L points.
-    9 bodies, 20 link constraints, 20 independent velocities. Benchmark only: the vehicle
-    itself (springs, tyres, rockers) is built elsewhere."""
-    from jaxveh import fe
-    from jaxveh.params import HARD_POINT_NAMES, hard_points_vehicle_frame, load_vehicle_data
-
-    data = load_vehicle_data()
-    hp = hard_points_vehicle_frame(data)
-    modal = fe.frame_modal_body(fe.load_frame(), 6, beta=0.01)
-    b = mb.SystemBuilder()
-    b.add_input("rack")
-    b.add_flexible_body("chassis", modal)
-    q = [jnp.zeros(12)]
-    for corner, pts in hp.items():
-        pts = np.asarray(pts)
-        front = corner.startswith("front")
-        track = float(data.track_front if front else data.track_rear)
-        x = float(data.a) if front else -float(data.b)
-        w = np.array([x, track / 2 * (1 if corner.endswith("left") else -1), ex.WHEEL_CENTRE_HEIGHT])
-        ub = data.unsprung_front if front else data.unsprung_rear
-        up, wh = f"{corner}.upright", f"{corner}.wheel"
-        b.add_rigid_body(up, float(ub.body.mass), np.asarray(ub.body.inertia), parent="chassis", rotation="zxy")
-        b.add_rigid_body(wh, 0.0, np.diag([0.0, float(ub.wheel_spin_inertia), 0.0]), parent=up,
-                         revolute=((0, 0, 0), (0, 1, 0)))
-        for n in ("A", "B", "E", "F", "L"):
-            kw = {"input": "rack", "input_direction": (0.0, 1.0, 0.0)} if (n == "L" and front) else {}
-            b.add_modal_point(f"{corner}.{n}", "chassis", f"{corner}.{n}", **kw)
-        for n in ("C", "H", "M"):
-            b.add_point(f"{corner}.{n}", up, pts[HARD_POINT_NAMES.index(n)] - w)
-        for link, pa, pq in ex.QUARTER_CAR_LINKS:
-            length = np.linalg.norm(pts[HARD_POINT_NAMES.index(pa)] - pts[HARD_POINT_NAMES.index(pq)])
-            b.add_link(f"{corner}.{link}", f"{corner}.{pa}", f"{corner}.{pq}", length)
-        b.add_independent(up, "uz")
-        b.add_independent(wh, "theta_dot")
-        q += [jnp.concatenate([jnp.asarray(w), jnp.zeros(3)]), jnp.zeros(1)]
-    for name in ("ux", "uy", "uz", "wx", "wy", "wz") + tuple(f"p{k}_dot" for k in range(6)):
-        b.add_independent("chassis", name)
-    system, params = b.build()
-    return system, params, jnp.concatenate(q)
-
-
 def bench_vector_fields():
     rows = []
     for name, system, params, q, z, inputs in cases():
@@ -126,7 +85,7 @@ def bench_vector_fields():
 
 def bench_vehicle_simulation():
     """1 s of free motion of the vehicle-scale topology (10 m/s forward, wheels spinning,
-    falling under gravity, chassis modes damped at beta = 1 %), Tsit5, rtol 1e-6."""
+    falling under gravity, chassis modes at 2.5 % modal damping), Tsit5, rtol 1e-6."""
     system, params, q0 = vehicle_scale_system()
     rack = lambda t: jnp.reshape(0.0 * t, (1,))  # noqa: E731
     z0 = jnp.zeros(system.n_dof)
@@ -134,7 +93,7 @@ def bench_vehicle_simulation():
     for corner in ("front_left", "front_right", "rear_left", "rear_right"):
         z0 = z0.at[system.independent.index(system.y_index(f"{corner}.wheel", "theta_dot"))].set(10.0 / 0.255)
     q0 = q0.at[6:12].set(1e-4)  # chassis modes slightly deflected
-    q0 = mb.assemble(system, params, q0, fixed=tuple(range(12)) + (18, 25, 32, 39), inputs=rack)
+    q0 = mb.assemble(system, params, q0, fixed=assembly_fixed(system), inputs=rack)
     run = jax.jit(lambda p: mb.simulate(system, p, q0, z0, 0.0, 1.0, ts=jnp.linspace(0.0, 1.0, 101), inputs=rack,
                                         rtol=1e-6, atol=1e-9))
     t0 = time.perf_counter()
