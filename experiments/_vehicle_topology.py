@@ -12,11 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxveh import multibody as mb
-
-try:  # the corner's constants moved from the multibody examples to jaxveh.vehicle
-    from jaxveh.vehicle import QUARTER_CAR_LINKS, WHEEL_CENTRE_HEIGHT
-except ImportError:
-    from jaxveh.multibody._examples import QUARTER_CAR_LINKS, WHEEL_CENTRE_HEIGHT
+from jaxveh.vehicle import QUARTER_CAR_LINKS, WHEEL_CENTRE_HEIGHT
 
 CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
 #: Chassis pivots whose FE mode shapes carry the (off-mesh) spring mount above each wheel.

@@ -18,7 +18,7 @@ import jax
 import jax.numpy as jnp
 
 import jaxveh  # noqa: F401  (float64)
-from jaxveh import multibody as mb
+from jaxveh import multibody as mb, vehicle
 from jaxveh.multibody import _examples as ex
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -42,8 +42,8 @@ def cases():
     s, p = ex.double_pendulum()
     q, z = ex.double_pendulum_state(s, p, (0.3, -0.5), (1.0, 2.0))
     yield "double pendulum", s, p, q, z, None
-    s, p = ex.quarter_car()
-    q, _ = ex.quarter_car_kinematics(s, p, 0.01, 0.002)
+    s, p = vehicle.quarter_car()
+    q, _ = vehicle.quarter_car_kinematics(s, p, 0.01, 0.002)
     yield "quarter car", s, p, q, jnp.asarray([0.1, 30.0]), (lambda t: jnp.reshape(0.002 + 0.0 * t, (1,)))
     s, p = ex.flexible_pendulum()
     q, z = ex.flexible_pendulum_state(s, 0.3, (1e-4, -1e-4))
@@ -61,11 +61,11 @@ def bench_vector_fields():
     for name, system, params, q, z, inputs in cases():
         vf = mb.vector_field(system)
         args = (params, inputs, None, None)
-        single = jax.jit(lambda t, q, z: vf(t, (q, z), args))
+        single = jax.jit(lambda t, q, z, vf=vf, args=args: vf(t, mb.State(q, z, jnp.zeros(0)), args))
         c1, e1 = _time(single, 0.0, q, z)
         qb = jnp.broadcast_to(q, (BATCH,) + q.shape)
         zb = jnp.broadcast_to(z, (BATCH,) + z.shape) * jnp.linspace(0.5, 1.5, BATCH)[:, None]
-        batched = jax.jit(jax.vmap(lambda q, z: vf(0.0, (q, z), args)))
+        batched = jax.jit(jax.vmap(lambda q, z, vf=vf, args=args: vf(0.0, mb.State(q, z, jnp.zeros(0)), args)))
         cb, eb = _time(batched, qb, zb, repeats=50)
         rows.append(
             {
