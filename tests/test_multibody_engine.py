@@ -42,6 +42,7 @@ def tip_pendulum():
     return _pendulum_with_tip()
 
 
+@pytest.mark.slow
 def test_spring_damper_element_equals_the_same_force_through_external(tip_pendulum):
     system, params, q, z = tip_pendulum
     k, c, l0 = 80.0, 3.0, 0.4
@@ -68,6 +69,7 @@ def test_spring_damper_element_equals_the_same_force_through_external(tip_pendul
     assert float(jnp.max(jnp.abs(with_element.q - free.q))) > 0.1  # the spring matters
 
 
+@pytest.mark.slow
 def test_first_order_lag_state_matches_closed_form():
     """``tau x_dot = t - x`` from x(0) = 0: ``x = t - tau (1 - exp(-t / tau))``."""
     system, params, q, z = _pendulum_with_tip()
@@ -98,6 +100,7 @@ def _yaw_table(k_t=40.0, k_s=2000.0, a=0.3, b=0.35):
     return system, params, elements
 
 
+@pytest.mark.slow
 def test_closed_loop_rack_settles_where_the_closed_form_says():
     """Rack actuator ``tau u_dot = r - K psi - u`` (an aux state) steering the table: the
     settled yaw solves ``k_t psi = k_s a (u cos psi - b sin psi)`` with ``u = r - K psi``."""
@@ -121,6 +124,7 @@ def test_closed_loop_rack_settles_where_the_closed_form_says():
     assert float(sim.aux[-1, 0]) == pytest.approx(ref - gain * root, abs=1e-7)
 
 
+@pytest.mark.slow
 def test_outputs_at_save_times_do_not_force_steps(tip_pendulum):
     system, params, q, z = tip_pendulum
     ts = jnp.linspace(0.0, 2.0, 401)
@@ -138,6 +142,7 @@ def test_outputs_at_save_times_do_not_force_steps(tip_pendulum):
     assert float(sim.max_residual) < 1e-9
 
 
+@pytest.mark.slow
 def test_event_stops_the_run_and_names_itself(tip_pendulum):
     system, params, q, z = tip_pendulum
     iy = system.q_index("B1", "rot2_x")
@@ -152,6 +157,7 @@ def test_event_stops_the_run_and_names_itself(tip_pendulum):
     assert not bool(sim.valid[-1])
 
 
+@pytest.mark.slow
 def test_linearised_double_pendulum_matches_closed_form():
     """Hanging double pendulum: ``det(K - w^2 M) = 0`` with the section 5.7 closed-form M
     and the Hessian of the potential energy; A and B (a torque on the lower bar) equal
@@ -171,6 +177,7 @@ def test_linearised_double_pendulum_matches_closed_form():
     eig = np.sort(np.abs(np.linalg.eigvals(np.asarray(lin.A)).imag))[::2]
     np.testing.assert_allclose(eig**2, w2, rtol=1e-9)
     q_of = mb.chart(system, params, q)
+    @jax.jit
     def f(x, w):
         return mb.minimal_rates(system, params, q_of, x[:2], x[2:], jnp.zeros(0), w, external=torque, with_args=True)
 
@@ -181,6 +188,7 @@ def test_linearised_double_pendulum_matches_closed_form():
     np.testing.assert_allclose(lin.B[:, 0], fd_b, atol=1e-6)
 
 
+@pytest.mark.slow
 def test_linearised_spring_mass_chain_matches_closed_form():
     """Three 2 kg bodies in a line joined to ground and to each other by 1000 N/m spring
     elements (fixed-free chain): eigenfrequencies ``2 sqrt(k/m) sin((2j - 1) pi / 14)``."""
@@ -205,6 +213,7 @@ def test_linearised_spring_mass_chain_matches_closed_form():
     np.testing.assert_allclose(freq[freq > 1e-3], expected, rtol=1e-10)
 
 
+@pytest.mark.slow
 def test_static_trim_of_the_yaw_table_and_its_implicit_gradient():
     """Held rack ``u``: the equilibrium yaw solves ``k_t psi = k_s a (u cos psi - b sin psi)``;
     d psi / d k_t by the implicit-function adjoint equals the closed form's derivative."""

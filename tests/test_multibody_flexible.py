@@ -86,6 +86,7 @@ def test_flexible_pendulum_energy_residual_and_deflection(pendulum):
     assert 0.0 < p_max < 1e-2  # small elastic deflection
 
 
+@pytest.mark.slow
 def test_table_7_2_simplifications_on_fe_chassis():
     """Free-floating FE chassis (6 modes) tumbling with modal motion: the constant mass
     matrix and neglected c keep a Lagrangian (energy conserved) but change the response;
@@ -169,6 +170,7 @@ def _pinned_frequencies(frame, n_modes):
     return np.sort(np.abs(eig.imag))[::2] / (2 * np.pi)
 
 
+@pytest.mark.slow
 def test_revolute_on_flexible_body_clamps_rotational_mode_shapes(pinned_tube):
     """A revolute joint on a flexible body holds the material rotation at the joint (frame
     rotation plus rotational mode shapes): with every elastic mode kept the pinned tube has

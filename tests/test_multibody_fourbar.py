@@ -4,6 +4,7 @@ with an independent SciPy solution of the hand-derived minimal-coordinate Lagran
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
 
 from jaxveh import multibody as mb
@@ -67,6 +68,7 @@ def _reference(theta0, omega0, ts, v):
     return sol.y[0]
 
 
+@pytest.mark.slow
 def test_four_bar_against_scipy_minimal_coordinates():
     v = ex.FOUR_BAR_DEFAULTS
     system, params = ex.four_bar()

@@ -86,6 +86,7 @@ def test_multipliers_are_joint_reactions_at_rest():
     np.testing.assert_allclose(lam[system.constraint_rows("C2")][:3], [0, 0, m2 * g], atol=1e-11)
 
 
+@pytest.mark.slow
 def test_energy_and_residual_in_simulation():
     system, params = ex.double_pendulum()
     q, z = ex.double_pendulum_state(system, params, (1.2, -0.5), (1.0, 2.0))

@@ -136,6 +136,7 @@ def drop_run(car):
     return jax.jit(run), params, rate
 
 
+@pytest.mark.slow
 def test_quarter_car_bounce_residual_and_energy(car, drop_run):
     system, _ = car
     run, params, rate = drop_run
