@@ -18,12 +18,11 @@ from ._forces import aux_names, aux_offsets
 from ._kinematics import (
     body_poses,
     body_velocities,
-    constraint_rates,
     constraints,
     marker_positions,
     qdot_from_velocities,
 )
-from ._projection import Inputs, _dependent, dynamics, input_values, projection, solve_s
+from ._projection import Inputs, _dependent, _jacobians, dynamics, input_values, projection, solve_s
 from ._system import System, SystemParams, checked_params
 
 #: Default gain (1/s) of the velocity-level drift stabilisation ``Phi_dot = -kappa Phi``.
@@ -230,12 +229,9 @@ def project_coordinates(system: System, params: SystemParams, q, t, inputs=None,
 
     def step(_, qq):
         u = input_values(system, inputs, t, qq.dtype, qq, aux)
-        poses = body_poses(system, params, qq)
-        phi = constraints(system, params, qq, u)
-        phi_y = jax.jacfwd(
-            lambda y: constraint_rates(system, params, poses, body_velocities(system, params, qq, y, poses), u)
-        )(jnp.zeros((system.n_y,), qq.dtype))
+        phi, _, _, phi_y = _jacobians(system, params, qq, u, jnp.zeros_like(u))
         dy = solve_s(system, jax.scipy.linalg.lu_factor(phi_y[:, dep]), -phi)
+        poses = body_poses(system, params, qq)
         vs = body_velocities(system, params, qq, dy, poses)
         return qq + qdot_from_velocities(system, params, qq, dy, vs, poses)
 
