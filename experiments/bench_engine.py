@@ -6,6 +6,8 @@ steering rack) with force elements standing in for the suspension and the tyres:
 vertical spring-damper per corner, a linear vertical tyre spring (Table B.4), a first-order
 lateral slip state per wheel (relaxation length 0.3 m) giving a linear lateral force, and
 light rolling resistance. The car coasts at 15 m/s and gets a smooth rack step at 0.5 s.
+Integrated IMEX (``simulate(..., implicit_modes=True)``: KenCarp4, the chassis modes'
+linear elastic and damping forces implicit); explicit Tsit5 timed beside it.
 
 Measures, through the public ``jaxveh.multibody`` API only: compile time, one vector-field
 evaluation, the 5 s run at rtol 1e-3 and 1e-6 (wall, steps, constraint residual), batched
@@ -232,15 +234,16 @@ def _count(name: str) -> None:
     TRACES[name] = TRACES.get(name, 0) + 1  # runs at trace time only
 
 
-def make_run(model: Model):
-    """``run(model, knobs, rtol, atol) -> Simulation`` (the 5 s step steer), not yet jitted."""
+def make_run(model: Model, implicit_modes: bool = True):
+    """``run(model, knobs, rtol, atol) -> Simulation`` (the 5 s step steer), not yet jitted.
+    ``implicit_modes``: IMEX (KenCarp4, chassis modes implicit), else explicit Tsit5."""
     ts = jnp.linspace(0.0, T_END, SAVE_TIMES)
 
     def run(model, knobs, rtol, atol):
         return mb.simulate(
             model.system, model.params, model.q0, model.z0, 0.0, T_END, ts,
             inputs=model.inputs(knobs), elements=model.elements(knobs), outputs=channels,
-            rtol=rtol, atol=atol, max_steps=MAX_STEPS,
+            rtol=rtol, atol=atol, max_steps=MAX_STEPS, implicit_modes=implicit_modes,
         )
 
     return run
@@ -252,8 +255,16 @@ def _timed(fn, *args):
     return out, time.perf_counter() - t0
 
 
-def bench_eval(model: Model, repeats: int = 300) -> float:
-    """Median wall time (µs) of one jitted vector-field evaluation at the initial state."""
+#: Vector-field evaluations per timed call in :func:`bench_eval` (inside one compiled loop,
+#: so the per-call dispatch of the argument pytree is not counted).
+EVALS_PER_CALL = 200
+
+
+def bench_eval(model: Model, repeats: int = 20) -> tuple[float, float]:
+    """``(in_loop_us, per_call_us)``: median time of one vector-field evaluation at the
+    initial state inside a compiled loop of ``EVALS_PER_CALL`` (each evaluation's input
+    depends on the previous result, so none is hoisted), and of one jitted call from Python
+    (adds the dispatch of the argument pytree, several hundred microseconds here)."""
     knobs = Knobs()
     elements = model.elements(knobs)
     n_aux = sum(len(e.aux_names) for e in elements)
@@ -264,10 +275,22 @@ def bench_eval(model: Model, repeats: int = 300) -> float:
         _count("vector_field")
         return vf(t, mb.State(q, z, aux), (model.params, model.inputs(knobs), None, None))
 
+    @jax.jit
+    def loop(t, q, z, aux):
+        _count("vector_field_loop")
+
+        def body(_, carry):
+            out = vf(t, mb.State(*carry), (model.params, model.inputs(knobs), None, None))
+            return carry[0] + 1e-12 * out.q, carry[1] + 1e-12 * out.z, carry[2] + 1e-12 * out.aux
+
+        return jax.lax.fori_loop(0, EVALS_PER_CALL, body, (q, z, aux))
+
     args = (jnp.asarray(STEP_START + 0.5 * STEP_RISE), model.q0, model.z0, jnp.full((n_aux,), 0.01))
     jax.block_until_ready(f(*args))
-    times = [_timed(f, *args)[1] for _ in range(repeats)]
-    return statistics.median(times) * 1e6
+    jax.block_until_ready(loop(*args))
+    per_call = statistics.median(_timed(f, *args)[1] for _ in range(15 * repeats))
+    in_loop = statistics.median(_timed(loop, *args)[1] for _ in range(repeats)) / EVALS_PER_CALL
+    return in_loop * 1e6, per_call * 1e6
 
 
 def bench_engine(quick: bool, log) -> dict:
@@ -279,8 +302,8 @@ def bench_engine(quick: bool, log) -> dict:
     rtol, atol = (jnp.asarray(x, jnp.float64) for x in TOLERANCES[0])
     sim, res["compile_s"] = _timed(run, model, knobs, rtol, atol)
     log(f"compile + first run: {res['compile_s']:.1f} s (status {int(sim.status)}: 0 completed)")
-    res["eval_us"] = bench_eval(model)
-    log(f"vector field: {res['eval_us']:.0f} us")
+    res["eval_us"], res["eval_call_us"] = bench_eval(model)
+    log(f"vector field: {res['eval_us']:.0f} us in a compiled loop, {res['eval_call_us']:.0f} us per call from Python")
     walls = []
     for _ in range(2):
         sim, wall = _timed(run, model, knobs, rtol, atol)
@@ -306,6 +329,18 @@ def bench_engine(quick: bool, log) -> dict:
     res["yaw_rate_difference_rtol_1e-3_vs_1e-6"] = float(
         jnp.max(jnp.abs(sim.outputs["yaw_rate"] - sim6.outputs["yaw_rate"])))
     log(f"5 s at rtol 1e-6: {res['wall_s_rtol_1e-6']:.2f} s, {res['steps_rtol_1e-6']} steps")
+
+    # the same runs with the explicit solver (Tsit5), for comparison
+    explicit = jax.jit(lambda model, knobs, rtol, atol: (_count("simulate_explicit"), make_run(model, False)(
+        model, knobs, rtol, atol))[1])
+    res["explicit"] = {}
+    for (rt, at), label in zip(TOLERANCES, ("rtol_1e-3", "rtol_1e-6")):
+        rt, at = jnp.asarray(rt, jnp.float64), jnp.asarray(at, jnp.float64)
+        sim_x, first = _timed(explicit, model, knobs, rt, at)
+        sim_x, wall = _timed(explicit, model, knobs, rt, at)
+        res["explicit"][label] = {"first_call_s": first, "wall_s": wall, "steps": int(sim_x.stats["num_steps"]),
+                                  "rejected_steps": int(sim_x.stats["num_rejected_steps"])}
+        log(f"explicit Tsit5, 5 s at {label}: {wall:.2f} s, {res['explicit'][label]['steps']} steps")
 
     # batches: a sweep of rack travel and cornering stiffness
     res["batch_sims_per_s"], res["batch_compile_s"], res["batch_steps_max"] = {}, {}, {}

@@ -39,6 +39,10 @@ from ._forces import (
     kinematics as kinematics,
     zero_forces as zero_forces,
 )
+from ._imex import (
+    ModalImplicitPart as ModalImplicitPart,
+    modal_implicit_part as modal_implicit_part,
+)
 from ._inputs import (
     AbstractInputs as AbstractInputs,
     StateInputs as StateInputs,
@@ -94,6 +98,7 @@ from ._simulate import (
     State as State,
     assemble as assemble,
     assembly_message as assembly_message,
+    default_imex_solver as default_imex_solver,
     independent_velocities as independent_velocities,
     joint_velocities as joint_velocities,
     project_coordinates as project_coordinates,
