@@ -1,9 +1,12 @@
-"""The chapter-6 vehicle, built with :mod:`jaxveh.multibody` (today: one corner).
+"""The chapter-6 vehicle, built with :mod:`jaxveh.multibody` (today: one corner and the
+push-rod force path).
 
 ``quarter_car`` builds the front-left (or rear-left) double-wishbone corner from the
 Appendix B hard points on a fixed chassis; ``quarter_car_kinematics`` sweeps it (camber,
 toe, track, wheel centre) and raises :class:`jaxveh.multibody.AssemblyError` for a travel
-that cannot be reached (or flags it in jitted sweeps).
+that cannot be reached (or flags it in jitted sweeps). The push-rod path (section 6.1.5,
+eqs. 6.4-6.12): wishbone frame and point D, the closed-form rocker angle, spring length,
+the rocker's moment balance and the wishbone's load distribution (see docs/vehicle.md).
 """
 
 from ._corner import (
@@ -16,4 +19,21 @@ from ._corner import (
     quarter_car_wheel_centre as quarter_car_wheel_centre,
     quarter_car_with_hard_points as quarter_car_with_hard_points,
     wheel_angles as wheel_angles,
+)
+from ._pushrod import (
+    RockerGeometry as RockerGeometry,
+    RockerLoads as RockerLoads,
+    WishboneGeometry as WishboneGeometry,
+    WishboneLoads as WishboneLoads,
+    beam_loads as beam_loads,
+    point_d as point_d,
+    rocker_angle as rocker_angle,
+    rocker_geometry as rocker_geometry,
+    rocker_loads as rocker_loads,
+    rocker_reach as rocker_reach,
+    rotate_about_axis as rotate_about_axis,
+    spring_length as spring_length,
+    wishbone_frame as wishbone_frame,
+    wishbone_geometry as wishbone_geometry,
+    wishbone_loads as wishbone_loads,
 )
