@@ -8,9 +8,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxveh import fe
+from jaxveh import fe, vehicle as pr
 from jaxveh.params import HARD_POINT_NAMES, hard_points_vehicle_frame, load_vehicle_data
-from jaxveh import vehicle as pr
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +43,7 @@ def test_point_d_rides_rigidly_on_the_wishbone(corner):
             d0 = {id(xd): c["D"], id(xc): c["C"]}.get(id(p), p)
             q0 = {id(xc): c["C"]}.get(id(q), q)
             np.testing.assert_allclose(jnp.linalg.norm(p - q), jnp.linalg.norm(d0 - q0), rtol=1e-13)
-    assert float(geo.m) > 0 and float(geo.n) > 0 and 0 < float(geo.a) < float(geo.l)
+    assert float(geo.m) > 0 and float(geo.n) > 0 and 0 < float(geo.a) < float(geo.length)
 
 
 def test_rocker_angle_closes_the_push_rod(corner):
@@ -122,16 +121,17 @@ def test_wishbone_loads_carry_the_force_and_its_moment():
 
 def test_thesis_equations_6_11_and_6_12_with_d_on_the_beam_line():
     """With D above the G-C line (d = 0) the derivation reproduces the thesis's terms."""
-    geo = pr.WishboneGeometry(m=jnp.asarray(0.2), n=jnp.asarray(0.15), l=jnp.asarray(0.33), d=jnp.asarray(0.0),
+    geo = pr.WishboneGeometry(m=jnp.asarray(0.2), n=jnp.asarray(0.15), length=jnp.asarray(0.33), d=jnp.asarray(0.0),
                               a=jnp.asarray(0.29), e=jnp.asarray(0.025))
     fx, fy, fz = 300.0, -800.0, 2500.0
     at_g, at_c, my, mz = pr.beam_loads(geo, jnp.asarray([fx, fy, fz]))
-    l, a, b, e = 0.33, 0.29, 0.33 - 0.29, 0.025
-    np.testing.assert_allclose(at_c, [a**2 / (2 * l**3) * (3 * l - a) * fx, a / l * fy, a / l * fz - e / l * fy],
-                               rtol=1e-13)
-    np.testing.assert_allclose(at_g, [b / (2 * l**3) * (3 * l**2 - b**2) * fx, b / l * fy, b / l * fz + e / l * fy],
-                               rtol=1e-13)
-    np.testing.assert_allclose(abs(float(mz)), b / (2 * l**2) * (l**2 - b**2) * fx, rtol=1e-13)
+    span, a, b, e = 0.33, 0.29, 0.33 - 0.29, 0.025  # the thesis's l, a, b, e
+    np.testing.assert_allclose(
+        at_c, [a**2 / (2 * span**3) * (3 * span - a) * fx, a / span * fy, a / span * fz - e / span * fy], rtol=1e-13)
+    np.testing.assert_allclose(
+        at_g, [b / (2 * span**3) * (3 * span**2 - b**2) * fx, b / span * fy, b / span * fz + e / span * fy],
+        rtol=1e-13)
+    np.testing.assert_allclose(abs(float(mz)), b / (2 * span**2) * (span**2 - b**2) * fx, rtol=1e-13)
     np.testing.assert_allclose(float(my), e * fx, rtol=1e-13)  # -> R_zA = n/p R_zG + e/p F_xD (6.12)
 
 
@@ -139,15 +139,16 @@ def test_beam_loads_against_a_finite_element_solution():
     """G-C as three Euler-Bernoulli elements (fe module), clamped at G except about the
     hinge axis x, pinned at C, loaded at D' (the foot of D) with the force and its offset
     moment: the support reactions equal the closed form."""
-    geo = pr.WishboneGeometry(m=jnp.asarray(0.2), n=jnp.asarray(0.15), l=jnp.asarray(0.33), d=jnp.asarray(0.012),
+    geo = pr.WishboneGeometry(m=jnp.asarray(0.2), n=jnp.asarray(0.15), length=jnp.asarray(0.33), d=jnp.asarray(0.012),
                               a=jnp.asarray(0.27), e=jnp.asarray(0.02))
     force = jnp.asarray([420.0, -900.0, 2600.0])
     at_g, at_c, my, mz = pr.beam_loads(geo, force)
-    l, a = float(geo.l), float(geo.a)
+    span, a = float(geo.length), float(geo.a)
     frame = fe.frame_from_dict({
         "materials": {"steel": {"E": 210.0, "G": 80.0, "density": 7850.0}},
         "sections": {"tube": {"shape": "circular", "diameter": 20.0, "thickness": 1.5}},
-        "nodes": {"G": [0.0, 0.0, 0.0], "D": [0.0, 1e3 * a / 2, 0.0], "Dp": [0.0, 1e3 * a, 0.0], "C": [0.0, 1e3 * l, 0.0]},
+        "nodes": {"G": [0.0, 0.0, 0.0], "D": [0.0, 1e3 * a / 2, 0.0], "Dp": [0.0, 1e3 * a, 0.0],
+                  "C": [0.0, 1e3 * span, 0.0]},
         "members": [{"nodes": ["G", "D"], "section": "tube", "divisions": 1},
                     {"nodes": ["D", "Dp"], "section": "tube", "divisions": 1},
                     {"nodes": ["Dp", "C"], "section": "tube", "divisions": 1}],

@@ -48,19 +48,19 @@ def wishbone_frame(xa: Vec, xb: Vec, xc: Vec) -> tuple[Float[Array, "3 3"], Vec]
 class WishboneGeometry(eqx.Module):
     """Fig. 6.4 parameters of one lower wishbone (m): ``m`` = A->G, ``n`` = G->B (along
     A->B, signed),
-    ``l`` = |G C| (the thesis's ``a + b``), and D in the wishbone frame relative to G:
+    ``length`` = |G C| (the thesis's ``l = a + b``), and D in the wishbone frame relative to G:
     ``d`` (along A->B), ``a`` (along G->C; ``b = l - a``), ``e`` (out of the plane)."""
 
     m: Float[Array, ""]
     n: Float[Array, ""]
-    l: Float[Array, ""]
+    length: Float[Array, ""]
     d: Float[Array, ""]
     a: Float[Array, ""]
     e: Float[Array, ""]
 
     @property
     def b(self):
-        return self.l - self.a
+        return self.length - self.a
 
     @property
     def d_local(self) -> Vec:
@@ -72,7 +72,7 @@ def wishbone_geometry(xa: Vec, xb: Vec, xc: Vec, xd: Vec) -> WishboneGeometry:
     w, xg = wishbone_frame(xa, xb, xc)
     local = w.T @ (xd - xg)
     m = jnp.dot(xg - xa, w[:, 0])  # signed: G may lie beyond A or B
-    return WishboneGeometry(m=m, n=jnp.linalg.norm(xb - xa) - m, l=jnp.linalg.norm(xc - xg), d=local[0],
+    return WishboneGeometry(m=m, n=jnp.linalg.norm(xb - xa) - m, length=jnp.linalg.norm(xc - xg), d=local[0],
                             a=local[1], e=local[2])
 
 
@@ -204,18 +204,18 @@ def beam_loads(geometry: WishboneGeometry, f_local: Vec) -> tuple[Vec, Vec, Floa
     simply supported beam. D sits ``(d, a, e)`` from G; its offset adds the moments
     ``(-e f_y, e f_x - d f_z, d f_y)`` at the beam point ``a``."""
     g = geometry
-    l, a, b = g.l, g.a, g.b
+    span, a, b = g.length, g.a, g.b
     fx, fy, fz = f_local[0], f_local[1], f_local[2]
     mx, my, mz = -g.e * fy, g.e * fx - g.d * fz, g.d * fy
     # axial: both ends held, shared by the segments' stiffness
-    cy = a / l * fy
+    cy = a / span * fy
     # out of plane: simply supported, moment about x at G balances
-    cz = (a * fz + mx) / l
+    cz = (a * fz + mx) / span
     # in plane: propped cantilever; tip compatibility of a cantilever under fx and mz at a
-    cx = a**2 * (3.0 * l - a) / (2.0 * l**3) * fx - 3.0 * (l**2 - b**2) / (2.0 * l**3) * mz
+    cx = a**2 * (3.0 * span - a) / (2.0 * span**3) * fx - 3.0 * (span**2 - b**2) / (2.0 * span**3) * mz
     at_c = jnp.stack([cx, cy, cz])
     at_g = f_local - at_c
-    moment_z = -a * fx + mz + l * cx  # moment about z carried by the clamp at G
+    moment_z = -a * fx + mz + span * cx  # moment about z carried by the clamp at G
     return at_g, at_c, my, moment_z
 
 
