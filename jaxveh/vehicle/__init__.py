@@ -37,3 +37,12 @@ from ._pushrod import (
     wishbone_geometry as wishbone_geometry,
     wishbone_loads as wishbone_loads,
 )
+from ._rates import (
+    AxleRates as AxleRates,
+    InstallationRatios as InstallationRatios,
+    axle_rates as axle_rates,
+    corner_sprung_masses as corner_sprung_masses,
+    design_rates as design_rates,
+    installation_ratios as installation_ratios,
+    roll_stiffness_distribution as roll_stiffness_distribution,
+)
