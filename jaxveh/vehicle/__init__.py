@@ -1,12 +1,13 @@
-"""The chapter-6 vehicle, built with :mod:`jaxveh.multibody` (today: one corner and the
-push-rod force path).
+"""The chapter-6 vehicle, built with :mod:`jaxveh.multibody` (today: one corner, the
+push-rod force path and the suspension rates).
 
 ``quarter_car`` builds the front-left (or rear-left) double-wishbone corner from the
 Appendix B hard points on a fixed chassis; ``quarter_car_kinematics`` sweeps it (camber,
 toe, track, wheel centre) and raises :class:`jaxveh.multibody.AssemblyError` for a travel
 that cannot be reached (or flags it in jitted sweeps). The push-rod path (section 6.1.5,
 eqs. 6.4-6.12): wishbone frame and point D, the closed-form rocker angle, spring length,
-the rocker's moment balance and the wishbone's load distribution (see docs/vehicle.md).
+the rocker's moment balance and the wishbone's load distribution; and the suspension rates
+they imply (installation ratios, wheel and ride rates, roll stiffness, λ; docs/vehicle.md).
 """
 
 from ._corner import (
