@@ -2,6 +2,7 @@
 implicit part is exactly the modal motion of a free body, IMEX runs agree with explicit
 ones, take fewer steps on stiff modes, and refuse systems without modes."""
 
+import diffrax
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -62,11 +63,15 @@ def test_imex_matches_explicit_with_fewer_steps(stiff_pendulum):
     np.testing.assert_allclose(loose_imex.q[:, 5], reference.q[:, 5], atol=1e-6)
 
 
-def test_implicit_modes_needs_modes():
+def test_implicit_modes_needs_modes_and_an_imex_solver(stiff_pendulum):
     system, params = ex.double_pendulum()
     q0, z0 = ex.double_pendulum_state(system, params, (0.3, -0.2), (0.0, 0.0))
     with pytest.raises(ValueError, match="flexible body with modes"):
         mb.simulate(system, params, q0, z0, 0.0, 0.1, implicit_modes=True)
+    system, params, _ = stiff_pendulum
+    q0, z0 = ex.flexible_pendulum_state(system)
+    with pytest.raises(ValueError, match="IMEX solver.*Tsit5"):
+        mb.simulate(system, params, q0, z0, 0.0, 0.1, implicit_modes=True, solver=diffrax.Tsit5())
 
 
 @pytest.mark.slow
