@@ -24,6 +24,7 @@ from ._corner import (
 from ._pushrod import (
     RockerGeometry as RockerGeometry,
     RockerLoads as RockerLoads,
+    RockerMount as RockerMount,
     WishboneGeometry as WishboneGeometry,
     WishboneLoads as WishboneLoads,
     beam_loads as beam_loads,
@@ -31,6 +32,8 @@ from ._pushrod import (
     rocker_angle as rocker_angle,
     rocker_geometry as rocker_geometry,
     rocker_loads as rocker_loads,
+    rocker_mount as rocker_mount,
+    rocker_on_chassis as rocker_on_chassis,
     rocker_reach as rocker_reach,
     rotate_about_axis as rotate_about_axis,
     spring_length as spring_length,
@@ -46,4 +49,11 @@ from ._rates import (
     design_rates as design_rates,
     installation_ratios as installation_ratios,
     roll_stiffness_distribution as roll_stiffness_distribution,
+)
+from ._suspension import (
+    CORNER_POINTS as CORNER_POINTS,
+    PushrodSuspension as PushrodSuspension,
+    corner_forces as corner_forces,
+    corner_state as corner_state,
+    pushrod_suspension as pushrod_suspension,
 )

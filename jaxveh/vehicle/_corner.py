@@ -32,7 +32,9 @@ QUARTER_CAR_LINKS = (
     ("upper_front", "F", "H"),
     ("track_rod", "L", "M"),
 )
-_CHASSIS_POINTS = ("A", "B", "E", "F", "L")
+#: Chassis-side points of the corner: the link pivots and the push-rod path's rocker axis
+#: (P, Q) and spring mount (T).
+_CHASSIS_POINTS = ("A", "B", "E", "F", "L", "P", "Q", "T")
 _UPRIGHT_POINTS = ("C", "H", "M")
 
 

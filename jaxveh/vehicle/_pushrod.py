@@ -230,3 +230,39 @@ def wishbone_loads(xa: Vec, xb: Vec, xc: Vec, geometry: WishboneGeometry, force_
     on_a = geometry.n / p * at_g + couple
     on_b = geometry.m / p * at_g - couple
     return WishboneLoads(on_a=w @ on_a, on_b=w @ on_b, on_c=w @ at_c)
+
+
+# ---------------------------------------------------------------------------------------
+# the rocker carried by the chassis
+# ---------------------------------------------------------------------------------------
+class RockerMount(eqx.Module):
+    """The rocker's R and S at design, in axes fixed by three chassis points: P (origin),
+    the axis u = P->Q and the direction of T perpendicular to it (``e``, ``u × e``, ``u``;
+    m), with the push-rod length and branch of :class:`RockerGeometry`. Rebuilt from the
+    current P, Q, T by :func:`rocker_on_chassis`, the rocker follows the chassis (and its
+    deformation at the mounts) with no reference to the chassis's orientation, so its angle
+    is a function of point positions only and its rate their ``jvp``."""
+
+    r_local: Vec
+    s_local: Vec
+    l_p: Float[Array, ""]
+    branch: Float[Array, ""]
+
+
+def _mount_axes(xp: Vec, xq: Vec, xt: Vec) -> Float[Array, "3 3"]:
+    u = _unit(xq - xp)
+    to_t = xt - xp
+    e = _unit(to_t - jnp.dot(to_t, u) * u)
+    return jnp.stack([e, jnp.cross(u, e), u], axis=1)
+
+
+def rocker_mount(rocker: RockerGeometry, xt: Vec) -> RockerMount:
+    """The mount of a rocker at design, with the spring's chassis end T."""
+    axes = _mount_axes(rocker.xp, rocker.xq, xt)
+    return RockerMount(axes.T @ (rocker.xr - rocker.xp), axes.T @ (rocker.xs - rocker.xp), rocker.l_p, rocker.branch)
+
+
+def rocker_on_chassis(mount: RockerMount, xp: Vec, xq: Vec, xt: Vec) -> RockerGeometry:
+    """The rocker (at its design angle) for the current chassis points P, Q, T."""
+    axes = _mount_axes(xp, xq, xt)
+    return RockerGeometry(xp, xq, xp + axes @ mount.r_local, xp + axes @ mount.s_local, mount.l_p, mount.branch)
