@@ -21,7 +21,8 @@ def corner():
     hp = {n: pts[k] for k, n in enumerate(HARD_POINT_NAMES)}
     system, params = vehicle.quarter_car(data, "front")
     design = vehicle.installation_ratios("front", data)
-    element = vehicle.pushrod_suspension(system, ("",), [hp], 30_000.0, design.spring_length + 0.012, 1500.0)
+    law = vehicle.linear_spring_damper(30_000.0, design.spring_length + 0.012, 1500.0)
+    element = vehicle.pushrod_suspension(system, ("",), [hp], law)
     return data, hp, system, params, element
 
 
@@ -39,7 +40,7 @@ def test_right_corner_mirrors_the_left(corner):
     (so the anti-roll bar, twisted by their sum, stays untwisted)."""
     data, hp, system, params, element = corner
     mirrored = {n: v * MIRROR[0] for n, v in hp.items()}
-    right = vehicle.pushrod_suspension(system, ("",), [mirrored], 30_000.0, 0.28, 0.0)
+    right = vehicle.pushrod_suspension(system, ("",), [mirrored], vehicle.linear_spring_damper(30_000.0, 0.28, 0.0))
     for bump in (-0.02, 0.0, 0.03):
         q, _ = vehicle.quarter_car_kinematics(system, params, bump, 0.0)
         x = _corner_points(system, params, q)
@@ -82,7 +83,7 @@ def test_static_wheel_load_is_spring_force_times_installation_ratio(corner):
     f_el = (mb.dynamics(system, params, q, z, 0.0, rack, elements=(element,)).external_forces
             - mb.dynamics(system, params, q, z, 0.0, rack).external_forces)
     ratio = vehicle.installation_ratios("front", data).spring
-    spring_force = 30_000.0 * 0.012  # compressed by 12 mm at design
+    spring_force = 30_000.0 * 0.012  # compressed by 12 mm at design (no bump stop)
     uz = system.independent.index(system.y_index("upright", "uz"))
     np.testing.assert_allclose(f_el[uz], spring_force * ratio, rtol=1e-10)
     assert float(f_el[uz]) < 0  # a compressed spring pushes the wheel down
@@ -94,17 +95,26 @@ def test_anti_roll_bar_on_an_axle(corner):
     untwisted, roll twists it."""
     data, hp, system, params, element = corner
     mirrored = {n: v * MIRROR[0] for n, v in hp.items()}
-    left = vehicle.pushrod_suspension(system, ("",), [hp], 1.0, 1.0, 0.0)  # geometry only
-    right = vehicle.pushrod_suspension(system, ("",), [mirrored], 1.0, 1.0, 0.0)
+    geometry_only = vehicle.linear_spring_damper(1.0, 1.0, 0.0)
+    left = vehicle.pushrod_suspension(system, ("",), [hp], geometry_only)
+    right = vehicle.pushrod_suspension(system, ("",), [mirrored], geometry_only)
 
     def concat(a, b):
         return jax.tree.map(lambda u, v: jnp.concatenate([u, v]), a, b)
 
+    def concat1(a, b):  # two single laws -> stacked
+        return jax.tree.map(lambda u, v: jnp.stack([u, v]), a, b)
+
+    # right: a progressive table with a bump stop near the static length (same table sizes)
+    progressive = vehicle.SpringDamperLaw(
+        spring_length=jnp.asarray([0.25, 0.281]), spring_force=jnp.asarray([900.0, 0.0]),
+        damper_rate=jnp.asarray([-1.0, 1.0]), damper_force=jnp.asarray([1300.0, -800.0]),
+        bump_stop_length=jnp.asarray(0.27), bump_stop_rate=jnp.asarray(2e5))
+
     both = vehicle.PushrodSuspension(
         points=(tuple(range(6)), tuple(range(6, 12))),  # rows of the hand-made kinematics below
         wishbone=concat(left.wishbone, right.wishbone), mount=concat(left.mount, right.mount),
-        spring_rate=jnp.asarray([30_000.0, 28_000.0]), free_length=jnp.asarray([0.28, 0.281]),
-        damping=jnp.asarray([900.0, 1100.0]), arb_rate=jnp.asarray(40.0))
+        law=concat1(vehicle.linear_spring_damper(30_000.0, 0.28, 900.0), progressive), arb_rate=jnp.asarray(40.0))
 
     def points(bumps):
         q_l, _ = vehicle.quarter_car_kinematics(system, params, bumps[0], 0.0, throw=False)

@@ -50,6 +50,12 @@ from ._rates import (
     installation_ratios as installation_ratios,
     roll_stiffness_distribution as roll_stiffness_distribution,
 )
+from ._springs import (
+    BUMP_STOP_ROUNDING as BUMP_STOP_ROUNDING,
+    SpringDamperLaw as SpringDamperLaw,
+    interpolate as interpolate,
+    linear_spring_damper as linear_spring_damper,
+)
 from ._suspension import (
     CORNER_POINTS as CORNER_POINTS,
     PushrodSuspension as PushrodSuspension,

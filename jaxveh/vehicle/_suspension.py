@@ -5,7 +5,8 @@ with the anti-roll bar between their rockers). From the global positions and vel
 each corner's points A, B (lower wishbone pivots), C (its ball joint on the upright), P, Q
 (rocker axis) and T (spring on the chassis) it evaluates the chain of :mod:`._pushrod`
 (point D, rocker angle, spring length, their rates by ``jax.jvp``), the spring-damper force
-``F_s = k (l0 - l_s) - c l_s_dot`` (N, positive in compression), the bar moment
+``F_s = F(l_s, l_s_dot)`` of its :class:`~._springs.SpringDamperLaw` (N, positive in
+compression; tables, bump stop), the bar moment
 ``M = -k_arb (θ_left + θ_right)`` on each rocker (the right side is the mirror image, so
 heave turns the rockers by opposite angles about their mirrored axes and only roll twists
 the bar), the rocker balance and the wishbone's load distribution, and applies the forces
@@ -33,6 +34,7 @@ from ._pushrod import (
     wishbone_geometry,
     wishbone_loads,
 )
+from ._springs import SpringDamperLaw
 
 #: Points of one corner the element reads and loads, in this order.
 CORNER_POINTS = ("A", "B", "C", "P", "Q", "T")
@@ -65,16 +67,14 @@ def corner_forces(x, wishbone: WishboneGeometry, mount: RockerMount, theta, spri
 class PushrodSuspension(AbstractForceElement):
     """Push-rod spring-dampers of one or two corners with an anti-roll bar (two corners:
     left then right). ``points`` (static): per corner the system's indices of
-    :data:`CORNER_POINTS`; ``wishbone``, ``mount``: per-corner geometry stacked on a leading
-    axis; ``spring_rate`` (N/m), ``free_length`` (m), ``damping`` (N s/m) per corner;
-    ``arb_rate`` (N m/rad of bar twist, two corners only). Build with :func:`pushrod_suspension`."""
+    :data:`CORNER_POINTS`; ``wishbone``, ``mount``, ``law``: per-corner geometry and
+    spring-damper law stacked on a leading axis; ``arb_rate`` (N m/rad of bar twist, two
+    corners only). Build with :func:`pushrod_suspension`."""
 
     points: tuple[tuple[int, ...], ...] = eqx.field(static=True)
     wishbone: WishboneGeometry
     mount: RockerMount
-    spring_rate: Float[Array, " nc"] = float_field()
-    free_length: Float[Array, " nc"] = float_field()
-    damping: Float[Array, " nc"] = float_field()
+    law: SpringDamperLaw
     arb_rate: Float[Array, ""] = float_field(default=0.0)
     aux_names: tuple[str, ...] = eqx.field(static=True, default=())
 
@@ -85,7 +85,7 @@ class PushrodSuspension(AbstractForceElement):
 
     def spring_forces(self, lengths, rates):
         """Spring-damper forces (N, positive in compression) per corner."""
-        return self.spring_rate * (self.free_length - lengths) - self.damping * rates
+        return jax.vmap(lambda law, length, rate: law(length, rate))(self.law, lengths, rates)
 
     def __call__(self, kin, aux, system):
         idx = np.asarray(self.points, dtype=int)
@@ -99,11 +99,12 @@ class PushrodSuspension(AbstractForceElement):
                              torques=out.torques, aux_dot=out.aux_dot)
 
 
-def pushrod_suspension(system, corners, hard_points, spring_rate, free_length, damping, arb_rate=0.0):
+def pushrod_suspension(system, corners, hard_points, law, arb_rate=0.0):
     """A :class:`PushrodSuspension` for ``corners`` (point-name prefixes in ``system``, e.g.
     ``("front_left.", "front_right.")`` or ``("",)`` for the quarter car) with their design
     hard points (one ``{name: xyz}`` per corner, m, any common frame: A, B, C, D, P, Q, R, S,
-    T). Rates, lengths and damping are scalars or one per corner."""
+    T) and spring-damper ``law`` (one for all corners, or one per corner with tables of
+    equal sizes)."""
     if not 1 <= len(corners) <= 2:
         raise ValueError(f"corners must name one corner or the two of an axle, got {len(corners)}")
     names = [[f"{c}{n}" for n in CORNER_POINTS] for c in corners]
@@ -120,13 +121,15 @@ def pushrod_suspension(system, corners, hard_points, spring_rate, free_length, d
     def stack(items):
         return jax.tree.map(lambda *x: jnp.stack(x), *items)
 
-    n = len(corners)
+    laws = [law] * len(corners) if isinstance(law, SpringDamperLaw) else list(law)
+    if len(laws) != len(corners):
+        raise ValueError(f"law: give one law or one per corner ({len(corners)}), got {len(laws)}")
+    if len({tuple(jnp.shape(a) for a in jax.tree.leaves(x)) for x in laws}) != 1:
+        raise ValueError("law: the corners' tables must have the same sizes to share one element")
     return PushrodSuspension(
         points=tuple(tuple(system.point_index(p) for p in row) for row in names),
         wishbone=stack(wishbones),
         mount=stack(mounts),
-        spring_rate=jnp.broadcast_to(jnp.asarray(spring_rate, jnp.float64), (n,)),
-        free_length=jnp.broadcast_to(jnp.asarray(free_length, jnp.float64), (n,)),
-        damping=jnp.broadcast_to(jnp.asarray(damping, jnp.float64), (n,)),
+        law=stack(laws),
         arb_rate=arb_rate,
     )
