@@ -10,6 +10,11 @@ the rocker's moment balance and the wishbone's load distribution; and the suspen
 they imply (installation ratios, wheel and ride rates, roll stiffness, λ; docs/vehicle.md).
 """
 
+from ._aero import (
+    AeroLoads as AeroLoads,
+    AeroMap as AeroMap,
+    aero_map_from_coefficients as aero_map_from_coefficients,
+)
 from ._corner import (
     QUARTER_CAR_LINKS as QUARTER_CAR_LINKS,
     WHEEL_CENTRE_HEIGHT as WHEEL_CENTRE_HEIGHT,
