@@ -15,6 +15,12 @@ from ._aero import (
     AeroMap as AeroMap,
     aero_map_from_coefficients as aero_map_from_coefficients,
 )
+from ._contact import (
+    WHEEL_STATES as WHEEL_STATES,
+    TyreContact as TyreContact,
+    contact_geometry as contact_geometry,
+    wheel_contact as wheel_contact,
+)
 from ._corner import (
     QUARTER_CAR_LINKS as QUARTER_CAR_LINKS,
     WHEEL_CENTRE_HEIGHT as WHEEL_CENTRE_HEIGHT,

@@ -1,0 +1,116 @@
+"""Tyres at the contact patch (thesis section 6.1.5, "Tyres"): a force element that puts MF
+5.2 tyres (:mod:`jaxveh.tyre`) under the wheels of a multibody system on a flat road.
+
+Per wheel, from the library's kinematics pass (global axes, z up, road at ``z = 0``):
+
+- spin axis ``a`` (the wheel body's y axis), road normal ``n``; ISO-W axes at the contact
+  point ``e_x = unit(a × n)`` (heading), ``e_y = n × e_x``; inclination
+  ``γ = asin(a · n)`` (positive with the top leaning to -y: the ISO-W sign, the same formula
+  for left and right wheels because every wheel axis points to the left);
+- the wheel plane meets the road at ``h = z_W / cos γ`` below the centre along the plane's
+  downward radial direction: contact point ``C``, deflection ``ρ = R0 - h`` and its rate (a
+  ``jvp`` with the centre's velocity and the axis's rate ``ω × a``), normal load
+  ``tyre.vertical_force(ρ, ρ_dot)`` (lift-off at zero);
+- slip velocities of the contact point carried by the upright: ``v_x``, ``v_sy`` along
+  ``e_x``, ``e_y``, and ``v_sx = v_x - Ω R_e(F_z)`` with the spin ``Ω`` of the wheel relative
+  to the upright;
+- two relaxation states per wheel (the contact deflections ``[u, v]``, m;
+  ``tyre.transient_slip_rhs``) give the lagged slips ``κ'``, ``α'`` of ``tyre_forces``;
+- the road's force ``F_x e_x + F_y e_y + F_z n`` and moment ``M_x e_x + M_y e_y + M_z n`` act
+  at ``C`` on the wheel body: at its centre point with the moment ``(C - W) × F + M``.
+
+The tyre's own mass, spin inertia and rolling radius belong to the bodies and the tyre file.
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ..multibody import AbstractForceElement, ElementForces, zero_forces
+from ..tyre import (
+    effective_rolling_radius,
+    transient_slip_rhs,
+    transient_slips,
+    tyre_forces,
+    vertical_force,
+)
+
+#: Auxiliary states of one wheel: longitudinal and lateral contact deflection (m).
+WHEEL_STATES = ("u", "v")
+_UP = jnp.asarray([0.0, 0.0, 1.0])
+
+
+def _unit(v):
+    return v / jnp.linalg.norm(v)
+
+
+def contact_geometry(centre, axis):
+    """``(e_x, e_y, γ, h, C)``: ISO-W heading and lateral axes, inclination (rad), distance
+    from the wheel centre to the road along the wheel plane (m) and the contact point (m)."""
+    e_x = _unit(jnp.cross(axis, _UP))
+    e_y = jnp.cross(_UP, e_x)
+    sin_gamma = jnp.dot(axis, _UP)
+    radial = _UP - sin_gamma * axis  # in the wheel plane, towards the top
+    cos_gamma = jnp.linalg.norm(radial)
+    h = centre[2] / cos_gamma
+    return e_x, e_y, jnp.arcsin(jnp.clip(sin_gamma, -1.0, 1.0)), h, centre - h * radial / cos_gamma
+
+
+def wheel_contact(tyre, centre, centre_velocity, axis, omega_wheel, omega_upright, deflection):
+    """One wheel: ``(force, moment about the centre, deflection rates, outputs)`` (global
+    axes, N and N m; outputs: ``fz``, ``kappa``, ``alpha``, ``gamma``, ``fx``, ``fy``)."""
+    axis_rate = jnp.cross(omega_upright, axis)
+    (e_x, e_y, gamma, h, contact), (_, _, _, h_dot, _) = jax.jvp(
+        contact_geometry, (centre, axis), (centre_velocity, axis_rate)
+    )
+    fz = vertical_force(tyre, tyre.unloaded_radius - h, -h_dot)
+    contact_velocity = centre_velocity + jnp.cross(omega_upright, contact - centre)
+    vx, vsy = jnp.dot(contact_velocity, e_x), jnp.dot(contact_velocity, e_y)
+    spin = jnp.dot(omega_wheel - omega_upright, axis)
+    vsx = vx - spin * effective_rolling_radius(tyre, fz)
+    rates = transient_slip_rhs(tyre, deflection, fz, gamma, vx, vsx, vsy)
+    kappa, alpha = transient_slips(tyre, deflection, fz, gamma)
+    f = tyre_forces(tyre, fz, kappa, alpha, gamma, vx)
+    force = f.fx * e_x + f.fy * e_y + jnp.maximum(fz, 0.0) * _UP
+    moment = f.mx * e_x + f.my * e_y + f.mz * _UP + jnp.cross(contact - centre, force)
+    outputs = {"fz": fz, "kappa": kappa, "alpha": alpha, "gamma": gamma, "fx": f.fx, "fy": f.fy}
+    return force, moment, rates, outputs
+
+
+class TyreContact(AbstractForceElement):
+    """MF 5.2 tyres under wheels on a flat road (see module). Static per wheel: ``wheel``
+    (a point on the wheel body at its centre) and ``upright`` (a point on the upright);
+    ``tyres`` the tyre of each wheel stacked on a leading axis (``jaxveh.tyre.stack_tyres``);
+    ``aux_names``: ``<name>.u``, ``<name>.v`` per wheel."""
+
+    wheel: tuple[int, ...] = eqx.field(static=True)
+    upright: tuple[int, ...] = eqx.field(static=True)
+    tyres: object
+    aux_names: tuple[str, ...] = eqx.field(static=True)
+
+    @classmethod
+    def on(cls, system, wheels: dict, tyres) -> "TyreContact":
+        """``wheels``: ``{name: (wheel-centre point on the wheel body, a point on the
+        upright)}``; ``tyres``: one stacked tyre per wheel, in the same order."""
+        names = list(wheels)
+        return cls(
+            wheel=tuple(system.point_index(wheels[n][0]) for n in names),
+            upright=tuple(system.point_index(wheels[n][1]) for n in names),
+            tyres=tyres,
+            aux_names=tuple(f"{n}.{s}" for n in names for s in WHEEL_STATES),
+        )
+
+    def evaluate(self, kin, aux):
+        """Per-wheel ``(force, moment, deflection rates, outputs)`` (leading axis: wheels)."""
+        w, u = np.asarray(self.wheel, int), np.asarray(self.upright, int)
+        axes = kin.point_rotations[w][:, :, 1]
+        return jax.vmap(wheel_contact)(self.tyres, kin.x[w], kin.xd[w], axes, kin.point_omega[w],
+                                       kin.point_omega[u], jnp.reshape(aux, (len(self.wheel), 2)))
+
+    def __call__(self, kin, aux, system):
+        force, moment, rates, _ = self.evaluate(kin, aux)
+        w = np.asarray(self.wheel, int)
+        out = zero_forces(kin)
+        return ElementForces(forces=out.forces.at[w].add(force), torques=out.torques.at[w].add(moment),
+                             aux_dot=jnp.reshape(rates, (-1,)))
