@@ -28,7 +28,7 @@ def _contact(centre, velocity, axis, spin, deflection=jnp.zeros(2), omega_uprigh
 
 def test_geometry_and_inclination_sign():
     centre = jnp.asarray([1.0, 2.0, R0 - DEFLECTION])
-    e_x, e_y, gamma, h, contact = vehicle.contact_geometry(centre, jnp.asarray([0.0, 1.0, 0.0]))
+    e_x, e_y, gamma, h, contact, _ = vehicle.contact_geometry(centre, jnp.asarray([0.0, 1.0, 0.0]))
     np.testing.assert_allclose(e_x, [1.0, 0.0, 0.0], atol=1e-15)
     np.testing.assert_allclose(e_y, [0.0, 1.0, 0.0], atol=1e-15)
     np.testing.assert_allclose(contact, [1.0, 2.0, 0.0], atol=1e-15)
@@ -36,7 +36,7 @@ def test_geometry_and_inclination_sign():
     # top leaning to -y by 3 deg: ISO-W inclination +3 deg; the plane meets the road further out
     g = np.radians(3.0)
     axis = jnp.asarray([0.0, np.cos(g), np.sin(g)])
-    _, _, gamma, h, contact = vehicle.contact_geometry(centre, axis)
+    _, _, gamma, h, contact, _ = vehicle.contact_geometry(centre, axis)
     np.testing.assert_allclose(gamma, g, rtol=1e-13)
     np.testing.assert_allclose(h, (R0 - DEFLECTION) / np.cos(g), rtol=1e-13)
     np.testing.assert_allclose(contact[2], 0.0, atol=1e-15)
@@ -123,3 +123,28 @@ def test_element_through_the_library(rig):
     np.testing.assert_allclose(dyn.z_dot[6], moment[1] / 0.3 - dyn.z_dot[4], rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(dyn.aux_dot, rates, rtol=1e-12)
     assert contact.aux_names == ("wheel.u", "wheel.v")
+
+
+def test_post_road_and_sloped_road():
+    """A post raised by 4 mm and rising at 0.1 m/s loads the tyre by kz (4 mm) plus the
+    damping of the closing rate; on a 5 % cross slope the normal tilts and the contact point
+    lies on the slope."""
+    centre = jnp.asarray([0.0, 0.0, R0 - DEFLECTION])
+    axis = jnp.asarray([0.0, 1.0, 0.0])
+    post = vehicle.PostRoad(lambda t: jnp.stack([0.004 + 0.1 * t, 0.0]))
+    omega = jnp.zeros(3)
+    _, _, _, out = vehicle.wheel_contact(TYRE, centre, jnp.zeros(3), axis, omega, omega, jnp.zeros(2), post, 0.0, 0)
+    expected = KZ * (DEFLECTION + 0.004) + float(TYRE.vertical_damping) * 0.1
+    np.testing.assert_allclose(out["fz"], expected, rtol=1e-12)
+    np.testing.assert_allclose(out["road_height"], 0.004, rtol=1e-12)
+
+    class Slope(vehicle.AbstractRoad):
+        def height(self, x, y, t, wheel):
+            return 0.05 * y
+
+    c2 = jnp.asarray([0.0, 0.4, 0.02 + R0 - DEFLECTION])
+    _, _, _, h, contact, normal = vehicle.contact_geometry(c2, axis, 0.02, (0.0, 0.05))
+    np.testing.assert_allclose(contact[2], 0.05 * contact[1], atol=1e-15)  # on the road
+    np.testing.assert_allclose(normal, np.array([0.0, -0.05, 1.0]) / np.sqrt(1.0025), rtol=1e-13)
+    _, _, _, out = vehicle.wheel_contact(TYRE, c2, jnp.zeros(3), axis, omega, omega, jnp.zeros(2), Slope())
+    np.testing.assert_allclose(out["gamma"], -np.arcsin(0.05 / np.sqrt(1.0025)), rtol=1e-12)

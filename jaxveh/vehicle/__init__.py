@@ -17,6 +17,9 @@ from ._aero import (
 )
 from ._contact import (
     WHEEL_STATES as WHEEL_STATES,
+    AbstractRoad as AbstractRoad,
+    FlatRoad as FlatRoad,
+    PostRoad as PostRoad,
     TyreContact as TyreContact,
     contact_geometry as contact_geometry,
     wheel_contact as wheel_contact,
