@@ -35,6 +35,13 @@ from ._corner import (
     quarter_car_with_hard_points as quarter_car_with_hard_points,
     wheel_angles as wheel_angles,
 )
+from ._powertrain import (
+    POWERTRAIN_STATES as POWERTRAIN_STATES,
+    AbstractSpeedTarget as AbstractSpeedTarget,
+    ConstantSpeed as ConstantSpeed,
+    Powertrain as Powertrain,
+    SpeedPID as SpeedPID,
+)
 from ._pushrod import (
     RockerGeometry as RockerGeometry,
     RockerLoads as RockerLoads,
