@@ -148,3 +148,28 @@ def test_post_road_and_sloped_road():
     np.testing.assert_allclose(normal, np.array([0.0, -0.05, 1.0]) / np.sqrt(1.0025), rtol=1e-13)
     _, _, _, out = vehicle.wheel_contact(TYRE, c2, jnp.zeros(3), axis, omega, omega, jnp.zeros(2), Slope())
     np.testing.assert_allclose(out["gamma"], -np.arcsin(0.05 / np.sqrt(1.0025)), rtol=1e-12)
+
+
+def test_gradients_against_finite_differences():
+    """d F_y / d (centre height) and d F_y / d (lateral contact deflection) through the
+    contact chain (deflection, load, relaxation, slip, MF) by jax.grad, against central
+    differences."""
+    v = 14.0
+    axis = jnp.asarray([0.0, np.cos(0.01), np.sin(0.01)])
+    re = float(tyre.effective_rolling_radius(TYRE, KZ * DEFLECTION))
+
+    def fy(height, lateral_deflection):
+        centre = jnp.asarray([0.0, 0.0, 0.0]).at[2].set(height)
+        velocity = jnp.asarray([v, 0.6, 0.0])
+        force, _, _, _ = _contact(centre, velocity, axis, v / re, jnp.stack([jnp.asarray(0.001), lateral_deflection]))
+        return force[1]
+
+    x0 = (jnp.asarray(R0 - DEFLECTION), jnp.asarray(0.01))
+    grads = jax.grad(fy, argnums=(0, 1))(*x0)
+    for k, h in ((0, 1e-6), (1, 1e-5)):
+        up = [x0[0], x0[1]]
+        down = [x0[0], x0[1]]
+        up[k], down[k] = x0[k] + h, x0[k] - h
+        fd = (float(fy(*up)) - float(fy(*down))) / (2 * h)
+        assert abs(float(grads[k])) > 1e3  # N/m: both matter
+        np.testing.assert_allclose(grads[k], fd, rtol=1e-6)
