@@ -14,7 +14,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._core import ParameterError, float_field, is_concrete
+from .._core import ParameterError, check_range, float_field, is_concrete
 from ..multibody import AbstractForceElement, ElementForces, zero_forces
 from ._springs import interpolate
 
@@ -49,10 +49,10 @@ def aero_map_from_coefficients(cda, cla, front_share, density=1.2, max_speed=40.
     ``cda`` and downforce area ``cla`` (m², >= 0), ``front_share`` of the downforce (0..1),
     air density (kg/m³). Between the table's points the law is piecewise linear (1 m/s apart by
     default: within 0.2 % of the quadratic law above 10 m/s)."""
-    for name, value, lo, hi in (("cda", cda, 0.0, np.inf), ("cla", cla, 0.0, np.inf),
-                                ("front_share", front_share, 0.0, 1.0), ("density", density, 0.0, np.inf)):
-        if is_concrete(value) and not lo <= float(value) <= hi:
-            raise ParameterError(f"{name} = {float(value)!r} is out of range: allowed [{lo}, {hi}]")
+    cda = check_range("cda", cda, low=0.0, what="m^2")
+    cla = check_range("cla", cla, low=0.0, what="m^2")
+    front_share = check_range("front_share", front_share, low=0.0, high=1.0)
+    density = check_range("density", density, low=0.0, low_open=True, what="kg/m^3")
     speed = jnp.linspace(0.0, max_speed, n)
     q = 0.5 * density * speed**2
     return AeroMap(speed=speed, drag=q * cda, downforce_front=q * cla * front_share,

@@ -22,7 +22,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._core import ParameterError, float_field, is_concrete
+from .._core import check_range, float_field, is_concrete
 from ..multibody import AbstractForceElement, ElementForces, zero_forces
 
 #: The powertrain's auxiliary states: speed-error integral (m) and filtered speed (m/s).
@@ -56,13 +56,11 @@ class SpeedPID(eqx.Module):
     t_max: Float[Array, ""] = float_field(default=1e4)
 
     def __check_init__(self):
-        checks = (("kp", self.kp, self.kp >= 0), ("ki", self.ki, self.ki >= 0), ("kd", self.kd, self.kd >= 0),
-                  ("tau", self.tau, self.tau > 0), ("t_min", self.t_min, self.t_min <= 0),
-                  ("t_max", self.t_max, self.t_max >= 0))
-        for name, value, ok in checks:
-            if is_concrete(ok) and not bool(ok):
-                raise ParameterError(f"{name} = {float(value)!r} is out of range (gains >= 0, tau > 0, "
-                                     "t_min <= 0 <= t_max)")
+        limits = {"kp": {"low": 0.0}, "ki": {"low": 0.0}, "kd": {"low": 0.0}, "tau": {"low": 0.0, "low_open": True},
+                  "t_min": {"high": 0.0}, "t_max": {"low": 0.0}}
+        for name, bounds in limits.items():
+            if is_concrete(getattr(self, name)):  # traced gains are the optimiser's business
+                check_range(name, getattr(self, name), **bounds)
 
     def torque(self, error, integral, error_rate):
         """``(saturated torque, unsaturated torque)`` (N m)."""

@@ -14,7 +14,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._core import ParameterError, float_field, is_concrete
+from .._core import ParameterError, check_range, float_field, is_concrete
 
 #: Length (m) over which the bump stop's force rises from zero to its linear law.
 BUMP_STOP_ROUNDING = 1e-3
@@ -58,8 +58,8 @@ class SpringDamperLaw(eqx.Module):
     def __check_init__(self):
         _check_table("spring table", self.spring_length, self.spring_force, "length")
         _check_table("damper table", self.damper_rate, self.damper_force, "rate")
-        if is_concrete(self.bump_stop_rate) and not float(self.bump_stop_rate) >= 0.0:
-            raise ParameterError(f"bump_stop_rate = {float(self.bump_stop_rate)!r} N/m is out of range: allowed >= 0")
+        if is_concrete(self.bump_stop_rate):
+            check_range("bump_stop_rate", self.bump_stop_rate, low=0.0, what="N/m")
 
     def spring(self, length):
         return interpolate(length, self.spring_length, self.spring_force)
@@ -78,12 +78,9 @@ class SpringDamperLaw(eqx.Module):
 def linear_spring_damper(rate, free_length, damping, bump_stop_length=0.0, bump_stop_rate=0.0) -> SpringDamperLaw:
     """The linear law ``k (l0 - l) - c l_dot`` (+ bump stop): spring rate ``k`` (N/m, > 0),
     free length ``l0`` (m, > 0), damping ``c`` (N s/m, >= 0)."""
-    for name, value, lower in (("rate", rate, 0.0), ("free_length", free_length, 0.0)):
-        if is_concrete(value) and not float(value) > lower:
-            raise ParameterError(f"{name} = {float(value)!r} is out of range: allowed > 0")
-    if is_concrete(damping) and not float(damping) >= 0.0:
-        raise ParameterError(f"damping = {float(damping)!r} N s/m is out of range: allowed >= 0")
-    rate, free_length, damping = (jnp.asarray(x, jnp.float64) for x in (rate, free_length, damping))
+    rate = check_range("rate", rate, low=0.0, low_open=True, what="N/m")
+    free_length = check_range("free_length", free_length, low=0.0, low_open=True, what="m")
+    damping = check_range("damping", damping, low=0.0, what="N s/m")
     return SpringDamperLaw(
         spring_length=jnp.stack([jnp.zeros_like(free_length), free_length]),
         spring_force=jnp.stack([rate * free_length, jnp.zeros_like(rate)]),
