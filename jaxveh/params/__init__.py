@@ -25,6 +25,10 @@ from ._appendix_b import (
     load_vehicle_data as load_vehicle_data,
     vehicle_data_from_dict as vehicle_data_from_dict,
 )
+from ._car_file import (
+    CarFile as CarFile,
+    read_car_file as read_car_file,
+)
 from ._checks import (
     NON_NEGATIVE as NON_NEGATIVE,
     POSITIVE as POSITIVE,

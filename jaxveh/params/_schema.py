@@ -34,6 +34,12 @@ UNIT_TO_SI: dict[str, float] = {
     "km/h": 1.0 / 3.6,
     "Hz": 1.0,
     "s": 1.0,
+    "Nm": 1.0,
+    "Nm s/m": 1.0,
+    "Nm s2/m": 1.0,
+    "m2": 1.0,
+    "kg/m3": 1.0,
+    "mm/deg": 1e-3 * 180.0 / math.pi,
 }
 
 

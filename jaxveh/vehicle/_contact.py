@@ -27,6 +27,7 @@ The tyre's own mass, spin inertia and rolling radius belong to the bodies and th
 """
 
 import abc
+import functools
 
 import equinox as eqx
 import jax
@@ -96,10 +97,11 @@ def contact_geometry(centre, axis, road_height=0.0, road_slope=(0.0, 0.0)):
 
 
 def wheel_contact(tyre, centre, centre_velocity, axis, omega_wheel, omega_upright, deflection,
-                  road: AbstractRoad = FlatRoad(), t=0.0, wheel=0):
+                  road: AbstractRoad = FlatRoad(), t=0.0, wheel=0, horizontal: bool = True):
     """One wheel: ``(force, moment about the centre, deflection rates, outputs)`` (global
     axes, N and N m; outputs: ``fz``, ``kappa``, ``alpha``, ``gamma``, ``fx``, ``fy``,
-    ``road_height``)."""
+    ``road_height``). ``horizontal=False`` keeps only the normal load (the wheel on a
+    frictionless plate, as on corner-weight scales with slip plates)."""
     axis_rate = jnp.cross(omega_upright, axis)
     t = jnp.asarray(t, centre.dtype)
 
@@ -118,6 +120,9 @@ def wheel_contact(tyre, centre, centre_velocity, axis, omega_wheel, omega_uprigh
     rates = transient_slip_rhs(tyre, deflection, fz, gamma, vx, vsx, vsy)
     kappa, alpha = transient_slips(tyre, deflection, fz, gamma)
     f = tyre_forces(tyre, fz, kappa, alpha, gamma, vx)
+    if not horizontal:
+        f = jax.tree.map(jnp.zeros_like, f)
+        rates = jnp.zeros_like(rates)
     force = f.fx * e_x + f.fy * e_y + jnp.maximum(fz, 0.0) * normal
     moment = f.mx * e_x + f.my * e_y + f.mz * normal + jnp.cross(contact - centre, force)
     outputs = {"fz": fz, "kappa": kappa, "alpha": alpha, "gamma": gamma, "fx": f.fx, "fy": f.fy,
@@ -129,16 +134,18 @@ class TyreContact(AbstractForceElement):
     """MF 5.2 tyres under wheels on a flat road (see module). Static per wheel: ``wheel``
     (a point on the wheel body at its centre) and ``upright`` (a point on the upright);
     ``tyres`` the tyre of each wheel stacked on a leading axis (``jaxveh.tyre.stack_tyres``);
-    ``aux_names``: ``<name>.u``, ``<name>.v`` per wheel."""
+    ``aux_names``: ``<name>.u``, ``<name>.v`` per wheel; ``horizontal`` (static): False
+    keeps only the normal loads (static set-up on frictionless plates)."""
 
     wheel: tuple[int, ...] = eqx.field(static=True)
     upright: tuple[int, ...] = eqx.field(static=True)
     tyres: object
     aux_names: tuple[str, ...] = eqx.field(static=True)
     road: AbstractRoad = FlatRoad()
+    horizontal: bool = eqx.field(static=True, default=True)
 
     @classmethod
-    def on(cls, system, wheels: dict, tyres, road: AbstractRoad = FlatRoad()) -> "TyreContact":
+    def on(cls, system, wheels: dict, tyres, road: AbstractRoad = FlatRoad(), horizontal: bool = True) -> "TyreContact":
         """``wheels``: ``{name: (wheel-centre point on the wheel body, a point on the
         upright)}``; ``tyres``: one stacked tyre per wheel, in the same order; ``road``."""
         names = list(wheels)
@@ -148,6 +155,7 @@ class TyreContact(AbstractForceElement):
             tyres=tyres,
             aux_names=tuple(f"{n}.{s}" for n in names for s in WHEEL_STATES),
             road=road,
+            horizontal=horizontal,
         )
 
     def evaluate(self, kin, aux):
@@ -155,7 +163,8 @@ class TyreContact(AbstractForceElement):
         w, u = np.asarray(self.wheel, int), np.asarray(self.upright, int)
         axes = kin.point_rotations[w][:, :, 1]
         n = len(self.wheel)
-        return jax.vmap(wheel_contact, in_axes=(0, 0, 0, 0, 0, 0, 0, None, None, 0))(
+        contact = functools.partial(wheel_contact, horizontal=self.horizontal)
+        return jax.vmap(contact, in_axes=(0, 0, 0, 0, 0, 0, 0, None, None, 0))(
             self.tyres, kin.x[w], kin.xd[w], axes, kin.point_omega[w], kin.point_omega[u],
             jnp.reshape(aux, (n, 2)), self.road, kin.t, jnp.arange(n))
 

@@ -1,0 +1,158 @@
+"""Static set-up of the car (section 6.1): the static equilibrium at rest by Newton root
+finding in minimal coordinates, with exact gradients by the implicit function theorem.
+
+At rest the car stands on frictionless plates (as on corner-weight scales with slip plates):
+the tyres carry their normal loads only, so the equilibrium is defined by the vertical load
+path alone (heave, roll, pitch, the chassis modes and the four suspension travels), and the
+remaining directions (x, y, yaw, wheel spins) are in equilibrium identically. The equations
+are the generalised forces ``R^T T^T (Q_int + Q_ext)`` in those directions at zero velocity
+(the accelerations would couple in the free directions through the mass matrix).
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+from jaxtyping import Array, Float
+
+from .._core import is_concrete
+from ..multibody import MultibodyError, chart, dynamics, rotation_matrix
+from ._corner import WHEEL_CENTRE_HEIGHT
+from ._car import CORNERS, Car, car_elements, design_coordinates, static_corner_loads, system_params
+
+#: Newton stops when the step (m, rad, modal units) is below ``atol + rtol |x|`` and the
+#: generalised forces (N, N m) below ``atol``.
+SETUP_RTOL, SETUP_ATOL = 1e-10, 1e-8
+
+
+class SetupError(MultibodyError):
+    """The static set-up did not converge."""
+
+
+class StaticState(eqx.Module):
+    """The car at rest. ``q`` coordinates; ``corner_loads`` tyre normal loads (N, FL, FR, RL,
+    RR); ``travel`` wheel-centre vertical travel relative to the chassis from the design
+    position (m, positive in bump); ``spring_forces`` (N, compression) and ``spring_lengths``
+    (m); ``rocker_angles`` (rad); ``ride_heights`` chassis-frame origin height above the road
+    under the front and rear axle (m; the design frame sits on the road, so this is the
+    change from the design drawing); ``pitch``, ``roll`` (rad); ``modes`` the chassis modal
+    coordinates; ``link_forces`` (N, tension positive, the links of Table 6.3 per corner);
+    ``residual`` largest generalised-force residual (N or N m) and ``ok``."""
+
+    q: Float[Array, " nq"]
+    corner_loads: Float[Array, "4"]
+    travel: Float[Array, "4"]
+    spring_forces: Float[Array, "4"]
+    spring_lengths: Float[Array, "4"]
+    rocker_angles: Float[Array, "4"]
+    ride_heights: Float[Array, "2"]
+    pitch: Float[Array, ""]
+    roll: Float[Array, ""]
+    modes: Float[Array, " nm"]
+    link_forces: Float[Array, "4 5"]
+    residual: Float[Array, ""]
+    ok: Array
+
+
+def vertical_directions(car: Car) -> np.ndarray:
+    """Indices of the independent velocities in the vertical load path: each upright's
+    vertical velocity, the chassis's heave, roll and pitch rates and its modal velocities."""
+    z = [2 * k for k in range(4)]
+    return np.asarray(z + [10, 11, 12] + [14 + k for k in range(car.n_modes)], dtype=int)
+
+
+def _guess(car: Car) -> Float[Array, " nq"]:
+    """Design position lowered by the mean static tyre deflection (the tyres touch the road)."""
+    v, t = car.params.vehicle, car.params.tyres
+    sink = WHEEL_CENTRE_HEIGHT - jnp.mean(t.unloaded_radius - static_corner_loads(v) / t.vertical_stiffness)
+    q = design_coordinates(car)
+    system = car.system
+    rows = [system.q_index("chassis", "z")] + [system.q_index(f"{c}.upright", "z") for c in CORNERS]
+    return q.at[np.asarray(rows)].add(-sink)
+
+
+def _residual_fn(free):
+    def residual(x, car):
+        sp = system_params(car)
+        q0 = _guess(car)
+        rack = jnp.zeros(1)
+        q_of = chart(car.system, sp, q0, 0.0, lambda t: rack, None)
+        s = jnp.zeros((car.system.n_dof,), x.dtype).at[free].set(x)
+        q = q_of(s)
+        elements = car_elements(car, powertrain=False, tyre_horizontal=False)
+        dyn = dynamics(car.system, sp, q, jnp.zeros((car.system.n_dof,)), 0.0, lambda t: rack, elements=elements,
+                       aux=jnp.zeros((8,)))
+        return (dyn.internal_forces + dyn.external_forces)[free], (q, dyn, elements)
+
+    return residual
+
+
+@eqx.filter_jit
+def _solve(car: Car, max_steps: int):
+    free = vertical_directions(car)
+    residual = _residual_fn(free)
+    solver = optx.Newton(rtol=SETUP_RTOL, atol=SETUP_ATOL)
+    sol = optx.root_find(lambda x, c: residual(x, c)[0], solver, jnp.zeros((free.size,)), car, max_steps=max_steps,
+                         throw=False)
+    f, (q, dyn, elements) = residual(sol.value, car)
+    return _state(car, q, dyn, elements, jnp.max(jnp.abs(f)), sol.result == optx.RESULTS.successful)
+
+
+def _state(car, q, dyn, elements, res, converged) -> StaticState:
+    system, kin = car.system, dyn.kinematics
+    front, rear, tyres = elements[0], elements[1], elements[2]
+    _, _, _, outs = tyres.evaluate(kin, jnp.zeros((8,)))
+    (lf, tf), (rf, _) = front.states(kin)
+    (lr, tr), (rr, _) = rear.states(kin)
+    lengths, thetas = jnp.concatenate([lf, lr]), jnp.concatenate([tf, tr])
+    forces = jnp.concatenate([front.spring_forces(lf, rf), rear.spring_forces(lr, rr)])
+    origin = q[:3]
+    a = rotation_matrix("zyx", q[3:6])
+    w_design = design_coordinates(car)
+    travel, heights = [], []
+    for c in CORNERS:
+        i = system.q_index(f"{c}.upright", "x")
+        local = a.T @ (q[i:i + 3] - origin)
+        local0 = w_design[i:i + 3]
+        travel.append(local[2] - local0[2])
+    v = car.params.vehicle
+    for x in (v.a, -v.b):
+        point = origin + a @ jnp.stack([x, jnp.zeros_like(x), jnp.zeros_like(x)])
+        heights.append(point[2])
+    links = []
+    for c in CORNERS:
+        rows = [system.constraint_names.index(n) for n in system.constraint_names if n.startswith(f"{c}.")]
+        links.append(dyn.multipliers[np.asarray(rows)])
+    return StaticState(
+        q=q,
+        corner_loads=outs["fz"],
+        travel=jnp.stack(travel),
+        spring_forces=forces,
+        spring_lengths=lengths,
+        rocker_angles=thetas,
+        ride_heights=jnp.stack(heights),
+        pitch=q[4],
+        roll=q[5],
+        modes=q[6:6 + car.n_modes],
+        link_forces=jnp.stack(links),
+        residual=res,
+        ok=converged & jnp.isfinite(res),
+    )
+
+
+def static_equilibrium(car: Car, max_steps: int = 32, throw: bool = True) -> StaticState:
+    """The car at rest on a flat road (see module). With ``throw`` a failed solve raises
+    :class:`SetupError` (a run-time error under ``jit``). Differentiable in ``car.params``."""
+    state = _solve(car, max_steps)
+    if not throw:
+        return state
+    if is_concrete(state.ok):
+        if not bool(state.ok):
+            raise SetupError(
+                f"static set-up failed: largest generalised-force residual {float(state.residual):.3e} after "
+                f"{max_steps} Newton steps; check that the springs can carry the car (free lengths, rates) and the "
+                "hard points assemble"
+            )
+        return state
+    return eqx.tree_at(lambda s: s.q, state, eqx.error_if(state.q, ~state.ok, "static set-up failed"))
