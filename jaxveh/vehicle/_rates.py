@@ -5,16 +5,19 @@ stiffness distribution λ, and spring / anti-roll-bar rates that reach chosen ta
 The installation ratios are exact derivatives (``jax.jvp``) of the push-rod chain of
 :mod:`._pushrod` driven by the quarter car's kinematics (:mod:`._corner`) with respect to
 the wheel-centre vertical travel. With ``dl_s/dz`` (spring) and ``dθ/dz`` (rocker) at a
-travel, an axle of track ``t`` has (small motions, the spring force's geometric stiffness
-left out, i.e. exact at zero preload):
+travel and the spring's static force ``F_s`` (N, compression; the preload carrying the
+car), an axle of track ``t`` has (small motions):
 
-    wheel rate      k_w = k_s (dl_s/dz)^2                                     (N/m)
+    wheel rate      k_w = k_s (dl_s/dz)^2 - F_s d²l_s/dz²                     (N/m)
     ride rate       k_r = k_w k_t / (k_w + k_t)     (tyre vertical stiffness k_t in series)
     ride frequency  f = sqrt(k_r / m_c) / 2π        (m_c the sprung mass on the corner)
     roll stiffness  K = k_w t^2 / 2 + k_arb (dθ/dz)^2 t^2                     (N m/rad)
 
 the anti-roll bar being a torsion spring ``k_arb`` (N m/rad) between the left and right
-rockers: heave does not twist it, roll twists it by ``(dθ/dz) t φ``. Roll stiffness here is
+rockers: heave does not twist it, roll twists it by ``(dθ/dz) t φ``. The second term of the
+wheel rate is the linkage's geometric stiffness: a rising-rate push-rod linkage
+(``d²l_s/dz² < 0``) makes a preloaded spring stiffer at the wheel (about +10 % on the
+default car). Roll stiffness here is
 the suspension's (rigid tyres), as ``k_F``, ``k_R`` of chapter 3 (Appendix A).
 """
 
@@ -36,10 +39,11 @@ _AXLES = ("front", "rear")
 
 class InstallationRatios(eqx.Module):
     """One corner's ratios at a wheel travel: ``spring`` = dl_s/dz (m/m, negative when the
-    spring shortens in bump), ``rocker`` = dθ/dz (rad/m), and there the spring length l_s
-    (m) and the rocker angle θ (rad, 0 at design)."""
+    spring shortens in bump), ``spring_curvature`` = d²l_s/dz² (1/m), ``rocker`` = dθ/dz
+    (rad/m), and there the spring length l_s (m) and the rocker angle θ (rad, 0 at design)."""
 
     spring: Float[Array, ""]
+    spring_curvature: Float[Array, ""]
     rocker: Float[Array, ""]
     spring_length: Float[Array, ""]
     rocker_angle: Float[Array, ""]
@@ -71,9 +75,13 @@ def installation_ratios(axle: str = "front", data=None, bump=0.0) -> Installatio
         theta = rocker_angle(rocker, point_d(xa, xb, x_c, wishbone))
         return spring_length(rocker, xt, theta), theta
 
+    def first(z):
+        return jax.jvp(chain, (z,), (jnp.ones_like(z),))
+
     bump = jnp.asarray(bump, jnp.float64)
-    (length, theta), (d_length, d_theta) = jax.jvp(chain, (bump,), (jnp.ones_like(bump),))
-    return InstallationRatios(spring=d_length, rocker=d_theta, spring_length=length, rocker_angle=theta)
+    ((length, theta), (d_length, d_theta)), (_, (dd_length, _)) = jax.jvp(first, (bump,), (jnp.ones_like(bump),))
+    return InstallationRatios(spring=d_length, spring_curvature=dd_length, rocker=d_theta, spring_length=length,
+                              rocker_angle=theta)
 
 
 class AxleRates(eqx.Module):
@@ -93,10 +101,12 @@ class AxleRates(eqx.Module):
         return self.roll_stiffness * math.pi / 180.0
 
 
-def axle_rates(ratios: InstallationRatios, spring_rate, arb_rate, track, tyre_rate, corner_sprung_mass) -> AxleRates:
+def axle_rates(ratios: InstallationRatios, spring_rate, arb_rate, track, tyre_rate, corner_sprung_mass,
+               spring_preload=0.0) -> AxleRates:
     """The module's formulas: spring rate (N/m), anti-roll-bar rate (N m/rad), track (m),
-    tyre vertical stiffness (N/m), sprung mass on one corner (kg)."""
-    wheel = spring_rate * ratios.spring**2
+    tyre vertical stiffness (N/m), sprung mass on one corner (kg), static spring force
+    (N, compression)."""
+    wheel = spring_rate * ratios.spring**2 - spring_preload * ratios.spring_curvature
     ride = wheel * tyre_rate / (wheel + tyre_rate)
     springs = wheel * track**2 / 2.0
     arb = arb_rate * (ratios.rocker * track) ** 2
@@ -122,10 +132,11 @@ def corner_sprung_masses(data=None) -> tuple[Float[Array, ""], Float[Array, ""]]
     return data.sprung.mass * data.b / (2.0 * wheelbase), data.sprung.mass * data.a / (2.0 * wheelbase)
 
 
-def design_rates(ratios: InstallationRatios, ride_frequency, roll_stiffness, track, tyre_rate, corner_sprung_mass):
+def design_rates(ratios: InstallationRatios, ride_frequency, roll_stiffness, track, tyre_rate, corner_sprung_mass,
+                 spring_preload=0.0):
     """``(spring_rate N/m, arb_rate N m/rad)`` giving one axle the ride frequency (Hz) and the
-    roll stiffness (N m/rad): the spring from the ride rate, the bar for the rest of the roll
-    stiffness. Raises ``ParameterError`` when the springs alone are stiffer in roll than the
+    roll stiffness (N m/rad) with the static spring force ``spring_preload`` (N): the spring
+    from the ride rate, the bar for the rest of the roll stiffness. Raises ``ParameterError`` when the springs alone are stiffer in roll than the
     target (the bar would need a negative rate) or the ride rate needs an infinite wheel rate."""
     ride = corner_sprung_mass * (2.0 * math.pi * ride_frequency) ** 2
     if is_concrete(ride) and float(ride) >= float(tyre_rate):
@@ -141,4 +152,5 @@ def design_rates(ratios: InstallationRatios, ride_frequency, roll_stiffness, tra
             f"{float(springs) * math.pi / 180:.4g} N m/deg at {float(ride_frequency):.3g} Hz: allowed only with a "
             "negative anti-roll-bar rate; lower the ride frequency or raise the roll stiffness"
         )
-    return wheel / ratios.spring**2, (roll_stiffness - springs) / (ratios.rocker * track) ** 2
+    spring = (wheel + spring_preload * ratios.spring_curvature) / ratios.spring**2
+    return spring, (roll_stiffness - springs) / (ratios.rocker * track) ** 2
