@@ -17,7 +17,7 @@ import optimistix as optx
 from jaxtyping import Array, Float
 
 from .._core import is_concrete
-from ..multibody import MultibodyError, chart, dynamics, rotation_matrix
+from ..multibody import MultibodyError, dynamics, rotation_matrix
 from ._corner import WHEEL_CENTRE_HEIGHT
 from ._car import CORNERS, Car, car_elements, design_coordinates, static_corner_loads, system_params
 
@@ -72,28 +72,38 @@ def _guess(car: Car) -> Float[Array, " nq"]:
     return q.at[np.asarray(rows)].add(-sink)
 
 
-def _residual_fn(free):
+def _held(car: Car) -> np.ndarray:
+    """Coordinates the set-up holds: the chassis's x, y and yaw and the wheel spin angles."""
+    system = car.system
+    rows = [system.q_index("chassis", n) for n in ("x", "y", "rot0_z")]
+    rows += [system.q_offsets[system.body_names.index(f"{c}.wheel")] for c in CORNERS]
+    return np.asarray(sorted(rows))
+
+
+def _residual_fn(car: Car):
+    """Residual on the free coordinates: the constraints and the generalised forces in the
+    vertical directions (a square system: one free coordinate per constraint or direction)."""
+    free_q = np.setdiff1d(np.arange(car.system.n_q), _held(car))
+    rows = vertical_directions(car)
+    rack = jnp.zeros(1)
+
     def residual(x, car):
         sp = system_params(car)
-        q0 = _guess(car)
-        rack = jnp.zeros(1)
-        q_of = chart(car.system, sp, q0, 0.0, lambda t: rack, None)
-        s = jnp.zeros((car.system.n_dof,), x.dtype).at[free].set(x)
-        q = q_of(s)
+        q = _guess(car).at[free_q].set(x)
         elements = car_elements(car, powertrain=False, tyre_horizontal=False)
         dyn = dynamics(car.system, sp, q, jnp.zeros((car.system.n_dof,)), 0.0, lambda t: rack, elements=elements,
                        aux=jnp.zeros((8,)))
-        return (dyn.internal_forces + dyn.external_forces)[free], (q, dyn, elements)
+        forces = (dyn.internal_forces + dyn.external_forces)[rows]
+        return jnp.concatenate([dyn.projection.phi, forces]), (q, dyn, elements)
 
-    return residual
+    return residual, free_q
 
 
 @eqx.filter_jit
 def _solve(car: Car, max_steps: int):
-    free = vertical_directions(car)
-    residual = _residual_fn(free)
+    residual, free_q = _residual_fn(car)
     solver = optx.Newton(rtol=SETUP_RTOL, atol=SETUP_ATOL)
-    sol = optx.root_find(lambda x, c: residual(x, c)[0], solver, jnp.zeros((free.size,)), car, max_steps=max_steps,
+    sol = optx.root_find(lambda x, c: residual(x, c)[0], solver, _guess(car)[free_q], car, max_steps=max_steps,
                          throw=False)
     f, (q, dyn, elements) = residual(sol.value, car)
     return _state(car, q, dyn, elements, jnp.max(jnp.abs(f)), sol.result == optx.RESULTS.successful)
