@@ -7,6 +7,7 @@ from ._chassis import app as chassis_app
 from ._multibody import app as multibody_app
 from ._run import run as run_command
 from ._tyre import app as tyre_app
+from ._vehicle import rig_app, vehicle_app
 
 app = typer.Typer(
     help="jaxveh: differentiable vehicle dynamics with a flexible chassis.",
@@ -18,6 +19,8 @@ app.add_typer(analytic_app, name="analytic")
 app.add_typer(tyre_app, name="tyre")
 app.add_typer(chassis_app, name="chassis")
 app.add_typer(multibody_app, name="multibody")
+app.add_typer(vehicle_app, name="vehicle")
+app.add_typer(rig_app, name="rig")
 
 
 def main() -> None:

@@ -11,3 +11,8 @@ from ._chapter3 import (
     plot_step_steer as plot_step_steer,
     save as save,
 )
+from ._rigs import (
+    plot_bump as plot_bump,
+    plot_roll as plot_roll,
+    plot_steer as plot_steer,
+)

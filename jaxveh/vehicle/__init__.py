@@ -1,5 +1,6 @@
-"""The chapter-6 vehicle, built with :mod:`jaxveh.multibody` (today: one corner, the
-push-rod force path and the suspension rates).
+"""The chapter-6 vehicle, built with :mod:`jaxveh.multibody`: the assembled 14-DOF car with
+its flexible chassis (``load_car``), its static set-up, kinematic rigs and rates, and its
+parts.
 
 ``quarter_car`` builds the front-left (or rear-left) double-wishbone corner from the
 Appendix B hard points on a fixed chassis; ``quarter_car_kinematics`` sweeps it (camber,
@@ -14,6 +15,25 @@ from ._aero import (
     AeroLoads as AeroLoads,
     AeroMap as AeroMap,
     aero_map_from_coefficients as aero_map_from_coefficients,
+)
+from ._car import (
+    CORNER_KEYS as CORNER_KEYS,
+    CORNERS as CORNERS,
+    MAX_MODES as MAX_MODES,
+    Car as Car,
+    CarParams as CarParams,
+    car_elements as car_elements,
+    design_coordinates as design_coordinates,
+    design_spring_lengths as design_spring_lengths,
+    load_car as load_car,
+    rest_spring_preloads as rest_spring_preloads,
+    sprung_cg as sprung_cg,
+    static_corner_loads as static_corner_loads,
+    steering as steering,
+    system_params as system_params,
+    total_mass as total_mass,
+    wheel_centres as wheel_centres,
+    with_rest_preloads as with_rest_preloads,
 )
 from ._contact import (
     WHEEL_STATES as WHEEL_STATES,
@@ -70,6 +90,24 @@ from ._rates import (
     design_rates as design_rates,
     installation_ratios as installation_ratios,
     roll_stiffness_distribution as roll_stiffness_distribution,
+)
+from ._report import (
+    bump_report as bump_report,
+    car_rates as car_rates,
+    roll_report as roll_report,
+    steer_report as steer_report,
+    spring_at_design as spring_at_design,
+    vehicle_info as vehicle_info,
+)
+from ._rigs import (
+    bump_rig as bump_rig,
+    roll_rig as roll_rig,
+    steer_rig as steer_rig,
+)
+from ._setup import (
+    SetupError as SetupError,
+    StaticState as StaticState,
+    static_equilibrium as static_equilibrium,
 )
 from ._springs import (
     BUMP_STOP_ROUNDING as BUMP_STOP_ROUNDING,

@@ -278,6 +278,12 @@ def design_coordinates(car: Car) -> Float[Array, " nq"]:
     return jnp.concatenate(q)
 
 
+def design_spring_lengths(vehicle: VehicleData) -> Float[Array, "4"]:
+    """Spring lengths |T - S| (m) of the four corners at the design position."""
+    hp = (vehicle.hard_points_front.points,) * 2 + (vehicle.hard_points_rear.points,) * 2
+    return jnp.stack([jnp.linalg.norm(_hard_point(p, "T") - _hard_point(p, "S")) for p in hp])
+
+
 def corner_hard_points(vehicle: VehicleData) -> dict[str, dict]:
     """``{corner: {point name: xyz}}`` in the vehicle frame (m), right corners mirrored."""
     hp = hard_points_vehicle_frame(vehicle)
@@ -381,10 +387,7 @@ def load_car(path: str | Path | None = None, modes: int = 6, form: str = "librar
               "tyre_front" if c.startswith("front") else "tyre_rear", file.where, v) for c in CORNERS])
     a, pt = file.sections["aero"], file.sections["powertrain"]
     sf, sr = file.sections["suspension_front"], file.sections["suspension_rear"]
-    from ._rates import installation_ratios
-
-    ratios = [installation_ratios(axle, v) for axle in ("front", "rear")]
-    rest = [ratios[0].spring_length] * 2 + [ratios[1].spring_length] * 2
+    rest = design_spring_lengths(v)
     params = CarParams(
         vehicle=v,
         chassis=chassis,
@@ -430,11 +433,7 @@ def with_rest_preloads(car: Car, iterations: int = 8) -> Car:
     carries its :func:`rest_spring_preloads` force at its design length (the perch
     adjusted after a change of spring, mass or hard point). Newton on the shift: exact
     for piecewise-linear tables in a few iterations."""
-    from ._rates import installation_ratios
-
-    v = car.params.vehicle
-    ratios = [installation_ratios(axle, v) for axle in ("front", "rear")]
-    rest = jnp.stack([ratios[0].spring_length] * 2 + [ratios[1].spring_length] * 2)
+    rest = design_spring_lengths(car.params.vehicle)
     preloads = rest_spring_preloads(car)
     laws = car.params.springs
 

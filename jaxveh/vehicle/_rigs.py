@@ -36,6 +36,11 @@ from ._setup import StaticState
 #: Newton steps allowed for each rig assembly (from the design configuration), and the
 #: largest constraint residual accepted (m).
 RIG_ITERATIONS, RIG_ATOL = 24, 1e-10
+#: Newton steps of the modal equilibrium of a flexible chassis, and the relative
+#: change of the modal coordinates accepted after them.
+MODAL_ITERATIONS, MODAL_TOL = 4, 1e-9
+#: Code of a rig point whose links closed but whose modes did not balance.
+MODES_UNBALANCED = -2
 AXLES = ("front", "rear")
 
 
@@ -56,7 +61,9 @@ def _fixed(car: Car) -> tuple[int, ...]:
 
 def _assemble(car, sp, q_guess, rack):
     """Close the links from ``q_guess`` holding :func:`_fixed`: Newton on the twenty free
-    upright coordinates (a square system), differentiable by the implicit function theorem."""
+    upright coordinates (a square system), differentiable by the implicit function theorem.
+    Returns ``(q, worst)``: ``worst`` is -1 when every link closed, else the constraint row
+    with the largest gap."""
     free = np.setdiff1d(np.arange(car.system.n_q), np.asarray(_fixed(car)))
     u = jnp.reshape(rack, (1,))
 
@@ -66,8 +73,9 @@ def _assemble(car, sp, q_guess, rack):
     sol = optx.root_find(residual, optx.Newton(rtol=1e-12, atol=RIG_ATOL), q_guess[free], q_guess,
                          max_steps=RIG_ITERATIONS, throw=False)
     q = q_guess.at[free].set(sol.value)
-    gap = jnp.max(jnp.abs(residual(sol.value, q_guess)))
-    return q, (sol.result == optx.RESULTS.successful) & (gap <= RIG_ATOL)
+    gaps = jnp.abs(residual(sol.value, q_guess))
+    ok = (sol.result == optx.RESULTS.successful) & (jnp.max(gaps) <= RIG_ATOL)
+    return q, jnp.where(ok, -1, jnp.argmax(jnp.where(jnp.isfinite(gaps), gaps, jnp.inf)))
 
 
 def _suspension_forces(car, sp, q, rack, axles=AXLES):
@@ -100,26 +108,37 @@ def _configuration(car, sp, q_ref, set_held, flexible):
     if not (flexible and m):
         return lambda s: closed(s, q_ref[modal_rows])
 
-    def modal_residual(p, s):
+    stiffness = sp.bodies[0].modal.stiffness_matrix()
+
+    def modal_loads(p, s):
+        """Generalised forces on the modes (N per modal unit) of gravity and the suspension,
+        by virtual work along the modes with the links closed (the elastic force apart)."""
         q, _, rack = closed(s, p)
         u = jnp.reshape(rack, (1,))
         forces = _suspension_forces(car, sp, q, rack)
         jac_x = jax.jacfwd(lambda pp: marker_positions(car.system, sp, closed(s, pp)[0], u))(p)
-        grad_v = jax.grad(lambda pp: _potential(car, sp, closed(s, pp)[0]))(p)
-        return jnp.einsum("pi,pij->j", forces, jac_x) - grad_v
+        grad_g = jax.grad(lambda pp: energy(car.system, sp, closed(s, pp)[0], jnp.zeros((car.system.n_y,)))["gravity"])(p)
+        return jnp.einsum("pi,pij->j", forces, jac_x) - grad_g
 
     def solve(s):
-        sol = optx.root_find(modal_residual, optx.Newton(rtol=1e-10, atol=1e-8), q_ref[modal_rows], s,
-                             max_steps=16, throw=False)
-        q, ok, rack = closed(s, sol.value)
-        return q, ok & (sol.result == optx.RESULTS.successful), rack
+        # K p = f(p) by Newton's method (the loads' dependence on p through the geometry is
+        # not negligible against the softest modes: fixed-point iteration does not converge)
+        def residual(p):
+            return stiffness @ p - modal_loads(p, s)
+
+        def sweep(_, p):
+            r, jac = residual(p), jax.jacfwd(residual)(p)
+            return p - jnp.linalg.solve(jac, r)
+
+        p = jax.lax.fori_loop(0, MODAL_ITERATIONS, sweep, q_ref[modal_rows])
+        change = jnp.max(jnp.abs(sweep(0, p) - p))
+        q, worst, rack = closed(s, p)
+        balanced = change <= MODAL_TOL * (1.0 + jnp.max(jnp.abs(p)))
+        return q, jnp.where((worst < 0) & ~balanced, MODES_UNBALANCED, worst), rack
 
     return solve
 
 
-def _potential(car, sp, q):
-    e = energy(car.system, sp, q, jnp.zeros((car.system.n_y,)))
-    return e["gravity"] + e["elastic"]
 
 
 # ---- wheel measures -------------------------------------------------------------------------
@@ -176,7 +195,7 @@ def _bump(car: Car, travel, axle: str, state, flexible: bool):
 
     def point(h):
         s = jnp.stack([h, h])
-        q, ok, _ = config(s)
+        q, worst, _ = config(s)
         m = _wheel_measures(car, sp, q, road_axes=False)
         w0 = design_coordinates(car)
         left, right = pads
@@ -188,7 +207,7 @@ def _bump(car: Car, travel, axle: str, state, flexible: bool):
             "wheel_centre_x": m["centre"][np.asarray(pads), 0],
             "wheel_centre_y": m["centre"][np.asarray(pads), 1],
             "fz": _pad_loads(car, sp, config, pads, s),
-            "ok": ok,
+            "worst": worst,
         }
 
     return jax.vmap(point)(travel)
@@ -199,8 +218,9 @@ def bump_rig(car: Car, travel, axle: str = "front", state: StaticState | None = 
     positive up) relative to the level chassis. Returns arrays over the travel with a
     trailing axis (left, right) where per wheel: ``travel`` (m, wheel centre relative to the
     chassis from the design position), ``camber``, ``toe`` (rad), ``wheel_centre_x``,
-    ``wheel_centre_y`` (m, chassis axes), ``fz`` (N, pad load); ``track`` (m) and ``ok``
-    (every link closed on the design branch; see :func:`check_rig`)."""
+    ``wheel_centre_y`` (m, chassis axes), ``fz`` (N, pad load); ``track`` (m) and ``worst``
+    (-1 where every link closed and the modes balanced; else the constraint row with the
+    largest gap, or ``MODES_UNBALANCED``; :func:`check_rig` raises on them)."""
     return _bump(car, jnp.asarray(travel, jnp.float64), axle, state, flexible)
 
 
@@ -232,7 +252,7 @@ def _steer(car: Car, angles, state, flexible: bool):
     v = car.params.vehicle
 
     def point(angle):
-        q, ok, _ = config(angle)
+        q, worst, _ = config(angle)
         m = _wheel_measures(car, sp, q, road_axes=False)
         left, right = m["steer"][0], m["steer"][1]
         inner, outer = jnp.where(angle >= 0, left, -right), jnp.where(angle >= 0, right, -left)
@@ -244,8 +264,8 @@ def _steer(car: Car, angles, state, flexible: bool):
             "camber": m["camber"][:2],
             "track": track,
             "scrub_radius": jnp.stack([_scrub_radius(car, sp, q, 0), _scrub_radius(car, sp, q, 1)]),
-            "ackermann": ackermann,
-            "ok": ok,
+            "ackermann": jnp.where(jnp.abs(angle) < 1e-6, jnp.nan, ackermann),
+            "worst": worst,
         }
 
     return jax.vmap(point)(angles)
@@ -256,8 +276,8 @@ def steer_rig(car: Car, steering_wheel_angle, state: StaticState | None = None, 
     array, positive left) with the chassis level and the wheel centres at design height.
     Per front wheel (left, right): ``steer`` (road-wheel angle, rad, positive left),
     ``camber`` (rad), ``scrub_radius`` (m); ``track`` (m); ``ackermann`` (%: the inner-outer
-    angle difference over the ideal one for the wheelbase and track; undefined, NaN-free
-    but meaningless, near zero steer); ``ok``."""
+    angle difference over the ideal one for the wheelbase and track;
+    NaN at zero steer, where it is undefined); ``worst`` (see :func:`bump_rig`)."""
     return _steer(car, jnp.asarray(steering_wheel_angle, jnp.float64), state, flexible)
 
 
@@ -279,10 +299,10 @@ def _roll(car: Car, angles, state, flexible: bool, axis_height):
         return jnp.stack([-jnp.sum(_suspension_forces(car, sp, q, rack, (axle,)) * dx) for axle in AXLES])
 
     def point(phi):
-        q, ok, _ = config(phi)
+        q, worst, _ = config(phi)
         m = _wheel_measures(car, sp, q, road_axes=True)
         moment, stiffness = jax.jvp(moments, (phi,), (jnp.ones_like(phi),))
-        return {"camber": m["camber"], "toe": m["toe"], "moment": moment, "stiffness": stiffness, "ok": ok}
+        return {"camber": m["camber"], "toe": m["toe"], "moment": moment, "stiffness": stiffness, "worst": worst}
 
     return jax.vmap(point)(angles)
 
@@ -294,5 +314,21 @@ def roll_rig(car: Car, roll, state: StaticState | None = None, flexible: bool = 
     loads do no work in roll, so the moment is the suspension's own) with every wheel centre
     held at its design height. Per corner (FL, FR, RL, RR): ``camber`` and ``toe`` (rad, road
     axes: roll camber, roll steer); per axle (front, rear): ``moment`` (N m, the
-    suspension's restoring roll moment) and ``stiffness`` (N m/rad, its derivative); ``ok``."""
+    suspension's restoring roll moment) and ``stiffness`` (N m/rad, its derivative); ``worst`` (see :func:`bump_rig`)."""
     return _roll(car, jnp.asarray(roll, jnp.float64), state, flexible, jnp.asarray(axis_height, jnp.float64))
+
+
+def check_rig(car: Car, name: str, result: dict) -> dict:
+    """Raise :class:`jaxveh.multibody.AssemblyError` naming the first failed point of a rig
+    sweep and why (the link and its gap, or unbalanced modes); return ``result``."""
+    from ..multibody import AssemblyError
+
+    worst = np.asarray(result["worst"]).ravel()
+    bad = np.flatnonzero(worst != -1)
+    if bad.size:
+        code = int(worst[bad[0]])
+        why = ("the chassis modes did not balance" if code == MODES_UNBALANCED else
+               f"link {car.system.constraint_names[code]} does not close (its gap exceeds {RIG_ATOL:g} m)")
+        raise AssemblyError(f"{name}: cannot assemble the car at sweep point {int(bad[0])} of {worst.size}: {why}; "
+                            "reduce the range or check the hard points")
+    return result

@@ -37,7 +37,9 @@ class StaticState(eqx.Module):
     (m); ``rocker_angles`` (rad); ``ride_heights`` chassis-frame origin height above the road
     under the front and rear axle (m; the design frame sits on the road, so this is the
     change from the design drawing); ``pitch``, ``roll`` (rad); ``modes`` the chassis modal
-    coordinates; ``link_forces`` (N, tension positive, the links of Table 6.3 per corner);
+    coordinates; ``twist`` the chassis's static twist (rad: the modal rotation about x
+    of the front axle's wishbone pivots A, B, E, F, mean, less the rear axle's; 0 when
+    rigid); ``link_forces`` (N, tension positive, the links of Table 6.3 per corner);
     ``residual`` largest generalised-force residual (N or N m) and ``ok``."""
 
     q: Float[Array, " nq"]
@@ -50,6 +52,7 @@ class StaticState(eqx.Module):
     pitch: Float[Array, ""]
     roll: Float[Array, ""]
     modes: Float[Array, " nm"]
+    twist: Float[Array, ""]
     link_forces: Float[Array, "4 5"]
     residual: Float[Array, ""]
     ok: Array
@@ -145,10 +148,25 @@ def _state(car, q, dyn, elements, res, converged) -> StaticState:
         pitch=q[4],
         roll=q[5],
         modes=q[6:6 + car.n_modes],
+        twist=chassis_twist(car, q[6:6 + car.n_modes]),
         link_forces=jnp.stack(links),
         residual=res,
         ok=converged & jnp.isfinite(res),
     )
+
+
+def chassis_twist(car: Car, modes) -> Float[Array, ""]:
+    """Twist (rad) of the chassis at modal coordinates ``modes``: mean roll rotation of the
+    front wishbone pivots less that of the rear ones (see :class:`StaticState`)."""
+    chassis = car.params.chassis
+    if chassis is None:
+        return jnp.zeros(())
+
+    def roll(corners):
+        idx = np.asarray([chassis.point_index(f"{c}.{n}") for c in corners for n in "ABEF"])
+        return jnp.mean(chassis.point_phi_rotation[idx, 0, :] @ modes)
+
+    return car.params.coupling * (roll(CORNERS[:2]) - roll(CORNERS[2:]))
 
 
 def static_equilibrium(car: Car, max_steps: int = 32, throw: bool = True) -> StaticState:

@@ -1,0 +1,143 @@
+"""``jaxveh vehicle`` and ``jaxveh rig``: the 14-DOF car's summary and its kinematic rigs."""
+
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from .._core import ParameterError
+from ._common import emit_json, fail, write_json
+
+vehicle_app = typer.Typer(help="The 14-DOF car with its flexible chassis: summary.", no_args_is_help=True)
+rig_app = typer.Typer(help="Quasi-static kinematic rigs of the car (Figs. 6.11, 6.12).", no_args_is_help=True)
+
+VehicleOpt = typer.Option(None, "--vehicle", help="car TOML file (default: the shipped car.toml)")
+ModesOpt = typer.Option(6, "--modes", help="chassis modes, 0 (rigid) to 20")
+JsonOpt = typer.Option(False, "--json", help="print only JSON on stdout")
+OutOpt = typer.Option(None, "--out", help="write JSON, CSV and a PNG into this folder")
+PointsOpt = typer.Option(21, "--points", help="points of the sweep (>= 3)")
+LoadedOpt = typer.Option(
+    False, "--loaded", help="hold the chassis modes as loaded at rest instead of balancing them at every point"
+)
+
+
+def _car(vehicle: Path | None, modes: int):
+    from .. import vehicle as veh
+
+    return veh.load_car(vehicle, modes=modes)
+
+
+def _errors():
+    from ..multibody import MultibodyError
+
+    return (ParameterError, MultibodyError)
+
+
+@vehicle_app.command()
+def info(vehicle: Path = VehicleOpt, modes: int = ModesOpt, as_json: bool = JsonOpt) -> None:
+    """Masses, static corner loads, wheel rates, ride frequencies, roll stiffness and λ,
+    chassis modes and model sizes."""
+    from .. import vehicle as veh
+
+    try:
+        out = veh.vehicle_info(_car(vehicle, modes))
+    except _errors() as e:
+        fail(str(e))
+    if as_json:
+        emit_json(out)
+        return
+    c = out["corner_loads_n"]
+    typer.echo(f"mass {out['total_mass_kg']:.1f} kg; corner loads FL {c['fl']:.1f} FR {c['fr']:.1f} "
+               f"RL {c['rl']:.1f} RR {c['rr']:.1f} N (front share {100 * out['front_load_share']:.2f} %)")
+    for axle in ("front", "rear"):
+        typer.echo(f"{axle}: wheel rate {out['wheel_rate_n_per_m'][axle] / 1e3:.2f} N/mm, ride "
+                   f"{out['ride_frequency_hz'][axle]:.2f} Hz, roll stiffness "
+                   f"{out['roll_stiffness_nm_per_deg'][axle]:.1f} Nm/deg")
+    typer.echo(f"roll stiffness distribution λ = {out['roll_stiffness_distribution']:.3f}")
+    modes_hz = ", ".join(f"{f:.1f}" for f in out["chassis_modes_hz"]) or "rigid chassis"
+    typer.echo(f"chassis modes (Hz): {modes_hz}")
+    m = out["model"]
+    typer.echo(f"{m['bodies']} bodies, {m['coordinates']} coordinates, {m['constraints']} constraints, "
+               f"{m['independent_velocities']} independent velocities, {m['auxiliary_states']} auxiliary states")
+
+
+def _sweep(points: int, limit: float) -> np.ndarray:
+    if points < 3:
+        fail(f"--points must be >= 3, got {points}")
+    return np.linspace(-limit, limit, points)
+
+
+def _write(out_dir: Path | None, name: str, report: dict, x_key: str, plot) -> None:
+    """JSON, one CSV per axle block and the figure into ``out_dir``."""
+    if out_dir is None:
+        return
+    from .. import plots
+
+    out_dir = Path(out_dir)
+    write_json(report, out_dir / f"{name}.json")
+    for block, values in report.items():
+        if not isinstance(values, dict) or not all(isinstance(v, list) for v in values.values()):
+            continue
+        keys = list(values)
+        x = report[x_key] if x_key in report else values[keys[0]]
+        rows = np.column_stack([x] + [[np.nan if v is None else v for v in values[k]] for k in keys])
+        header = ",".join([x_key] + keys) if x_key in report else ",".join(keys)
+        data = rows if x_key in report else rows[:, 1:]
+        np.savetxt(out_dir / f"{name}_{block}.csv", data, delimiter=",", header=header, comments="")
+    plots.save(plot(report, title=f"{name} rig"), out_dir / f"{name}.png")
+
+
+def _run_rig(name, make, vehicle, modes, points, limit, loaded, out_dir, as_json, x_key, plot):
+    from .. import vehicle as veh
+
+    try:
+        car = _car(vehicle, modes)
+        state = veh.static_equilibrium(car) if (loaded and modes) else None
+        start = time.perf_counter()
+        report = make(car, _sweep(points, limit), not loaded, state)
+        report["elapsed_s"] = time.perf_counter() - start
+        report["modes"] = modes
+        report["chassis"] = "rigid" if modes == 0 else ("loaded at rest" if loaded else "flexible")
+    except _errors() as e:
+        fail(str(e))
+    _write(out_dir, name, report, x_key, plot)
+    if as_json:
+        emit_json(report)
+    else:
+        typer.echo(f"{name} rig: {points} points in {report['elapsed_s']:.1f} s (compilation included)"
+                   + (f"; wrote {out_dir}" if out_dir else ""))
+
+
+@rig_app.command()
+def bump(vehicle: Path = VehicleOpt, modes: int = ModesOpt, points: int = PointsOpt,
+         travel: float = typer.Option(50.0, "--travel", help="largest wheel travel (mm), swept +-"),
+         loaded: bool = LoadedOpt, out: Path = OutOpt, as_json: bool = JsonOpt) -> None:
+    """Bump test: both wheels of each axle moved vertically (Fig. 6.11)."""
+    from .. import plots, vehicle as veh
+
+    _run_rig("bump", veh.bump_report, vehicle, modes, points, travel, loaded, out, as_json, "travel_mm",
+             plots.plot_bump)
+
+
+@rig_app.command()
+def steer(vehicle: Path = VehicleOpt, modes: int = ModesOpt, points: int = PointsOpt,
+          angle: float = typer.Option(120.0, "--angle", help="largest steering-wheel angle (deg), swept +-"),
+          loaded: bool = LoadedOpt, out: Path = OutOpt, as_json: bool = JsonOpt) -> None:
+    """Steering test: the steering wheel turned (Fig. 6.12)."""
+    from .. import plots, vehicle as veh
+
+    _run_rig("steer", veh.steer_report, vehicle, modes, points, angle, loaded, out, as_json,
+             "steering_wheel_deg", plots.plot_steer)
+
+
+@rig_app.command()
+def roll(vehicle: Path = VehicleOpt, modes: int = ModesOpt, points: int = PointsOpt,
+         angle: float = typer.Option(2.0, "--angle", help="largest chassis roll (deg), swept +-"),
+         loaded: bool = LoadedOpt, out: Path = OutOpt, as_json: bool = JsonOpt) -> None:
+    """Roll test: the chassis rolled with the wheels on the ground (roll camber, roll steer,
+    roll stiffness per axle)."""
+    from .. import plots, vehicle as veh
+
+    _run_rig("roll", veh.roll_report, vehicle, modes, points, angle, loaded, out, as_json, "roll_deg",
+             plots.plot_roll)
