@@ -95,8 +95,8 @@ from ._report import (
     bump_report as bump_report,
     car_rates as car_rates,
     roll_report as roll_report,
-    steer_report as steer_report,
     spring_at_design as spring_at_design,
+    steer_report as steer_report,
     vehicle_info as vehicle_info,
 )
 from ._rigs import (

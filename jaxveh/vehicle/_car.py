@@ -25,7 +25,6 @@ reach hard points, rates, masses, modal data and tyre coefficients, and a new va
 retraces.
 """
 
-import math
 from pathlib import Path
 
 import equinox as eqx
@@ -142,7 +141,8 @@ def _chassis_body(params: CarParams):
         return RigidBody(mass=v.sprung.mass, inertia=v.sprung.inertia, cg=c)
     m = v.sprung.mass
     j_origin = v.sprung.inertia + m * (jnp.dot(c, c) * jnp.eye(3) - jnp.outer(c, c))
-    modal = eqx.tree_at(lambda b: (b.invariants.mass, b.invariants.c0, b.invariants.J0), params.chassis, (m, c, j_origin))
+    modal = eqx.tree_at(lambda b: (b.invariants.mass, b.invariants.c0, b.invariants.J0), params.chassis,
+                        (m, c, j_origin))
     return FlexibleBody(modal=modal, coupling=params.coupling)
 
 

@@ -136,8 +136,9 @@ def design_rates(ratios: InstallationRatios, ride_frequency, roll_stiffness, tra
                  spring_preload=0.0):
     """``(spring_rate N/m, arb_rate N m/rad)`` giving one axle the ride frequency (Hz) and the
     roll stiffness (N m/rad) with the static spring force ``spring_preload`` (N): the spring
-    from the ride rate, the bar for the rest of the roll stiffness. Raises ``ParameterError`` when the springs alone are stiffer in roll than the
-    target (the bar would need a negative rate) or the ride rate needs an infinite wheel rate."""
+    from the ride rate, the bar for the rest of the roll stiffness. Raises ``ParameterError``
+    when the springs alone are stiffer in roll than the target (the bar would need a
+    negative rate) or the ride rate needs an infinite wheel rate."""
     ride = corner_sprung_mass * (2.0 * math.pi * ride_frequency) ** 2
     if is_concrete(ride) and float(ride) >= float(tyre_rate):
         raise ParameterError(

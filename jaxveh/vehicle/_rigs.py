@@ -29,8 +29,8 @@ import optimistix as optx
 
 from .._core import GRAVITY
 from ..multibody import body_poses, constraints, energy, kinematics, marker_positions
-from ._corner import WHEEL_CENTRE_HEIGHT
 from ._car import CORNERS, Car, car_elements, design_coordinates, system_params
+from ._corner import WHEEL_CENTRE_HEIGHT
 from ._setup import StaticState
 
 #: Newton steps allowed for each rig assembly (from the design configuration), and the
@@ -117,7 +117,8 @@ def _configuration(car, sp, q_ref, set_held, flexible):
         u = jnp.reshape(rack, (1,))
         forces = _suspension_forces(car, sp, q, rack)
         jac_x = jax.jacfwd(lambda pp: marker_positions(car.system, sp, closed(s, pp)[0], u))(p)
-        grad_g = jax.grad(lambda pp: energy(car.system, sp, closed(s, pp)[0], jnp.zeros((car.system.n_y,)))["gravity"])(p)
+        rest = jnp.zeros((car.system.n_y,))
+        grad_g = jax.grad(lambda pp: energy(car.system, sp, closed(s, pp)[0], rest)["gravity"])(p)
         return jnp.einsum("pi,pij->j", forces, jac_x) - grad_g
 
     def solve(s):
@@ -314,7 +315,8 @@ def roll_rig(car: Car, roll, state: StaticState | None = None, flexible: bool = 
     loads do no work in roll, so the moment is the suspension's own) with every wheel centre
     held at its design height. Per corner (FL, FR, RL, RR): ``camber`` and ``toe`` (rad, road
     axes: roll camber, roll steer); per axle (front, rear): ``moment`` (N m, the
-    suspension's restoring roll moment) and ``stiffness`` (N m/rad, its derivative); ``worst`` (see :func:`bump_rig`)."""
+    suspension's restoring roll moment) and ``stiffness`` (N m/rad, its derivative);
+    ``worst`` (see :func:`bump_rig`)."""
     return _roll(car, jnp.asarray(roll, jnp.float64), state, flexible, jnp.asarray(axis_height, jnp.float64))
 
 

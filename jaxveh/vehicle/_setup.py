@@ -10,7 +10,6 @@ are the generalised forces ``R^T T^T (Q_int + Q_ext)`` in those directions at ze
 """
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
@@ -18,8 +17,8 @@ from jaxtyping import Array, Float
 
 from .._core import is_concrete
 from ..multibody import MultibodyError, dynamics, rotation_matrix
-from ._corner import WHEEL_CENTRE_HEIGHT
 from ._car import CORNERS, Car, car_elements, design_coordinates, static_corner_loads, system_params
+from ._corner import WHEEL_CENTRE_HEIGHT
 
 #: Newton stops when the step (m, rad, modal units) is below ``atol + rtol |x|`` and the
 #: generalised forces (N, N m) below ``atol``.
