@@ -111,7 +111,8 @@ def test_flexible_differs_from_rigid_by_the_sag(rigid_state, flexible_state):
 
 def test_stiff_modes_tend_to_the_rigid_car(flexible, rigid_state):
     """Modal stiffness multiplier µ -> large: the flexible car's static state -> the rigid one."""
-    stiff = eqx.tree_at(lambda c: c.params.chassis.stiffness_scale, flexible, flexible.params.chassis.stiffness_scale * 1e6)
+    scale = flexible.params.chassis.stiffness_scale * 1e6
+    stiff = eqx.tree_at(lambda c: c.params.chassis.stiffness_scale, flexible, scale)
     state = vehicle.static_equilibrium(stiff)
     np.testing.assert_allclose(state.corner_loads, rigid_state.corner_loads, rtol=1e-8)
     np.testing.assert_allclose(state.travel, rigid_state.travel, atol=1e-8)
