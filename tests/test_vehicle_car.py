@@ -119,6 +119,42 @@ def test_stiff_modes_tend_to_the_rigid_car(flexible, rigid_state):
     assert np.max(np.abs(np.asarray(state.modes))) < 1e-8
 
 
+@pytest.fixture(scope="module")
+def running(rigid):
+    return vehicle.straight_running(rigid, 20.0)
+
+
+def test_straight_running_balances_weight_downforce_and_drag(rigid, running):
+    """At 20 m/s: tyres carry weight + downforce (less the drag's share along the pitched
+    chassis axis), the rear tyres' drive forces balance drag, no yaw; the downforce compresses
+    the suspensions."""
+    s = running.static
+    assert bool(s.ok) and float(s.constraint_residual) < 1e-9
+    pitch = float(s.pitch)
+    vertical = 290.0 * G + float(running.downforce) * math.cos(pitch) - float(running.drag) * math.sin(pitch)
+    np.testing.assert_allclose(float(jnp.sum(s.corner_loads)), vertical, rtol=1e-9)
+    assert float(running.z[13]) == 0.0 and abs(float(running.rack)) < 1e-3  # straight: small correction only
+    np.testing.assert_allclose(running.z[np.array([1, 3, 5, 7])], 20.0 / 0.245, rtol=0.05)  # rolling wheels
+    assert np.all(np.asarray(s.travel) > 0.005)  # downforce: the car sits lower
+    # drive torque = (drag + rolling resistance) x rolling radius, rolling resistance a few percent
+    ratio = float(running.drive_torque) / (float(running.drag) * 0.245)
+    assert 1.0 < ratio < 1.5
+
+
+@pytest.mark.slow
+def test_standstill_settles(rigid, rigid_state):
+    """From the static set-up with the tyres' horizontal forces switched on: no NaN, the car
+    stays put (the tyre deflection states take up the small force offsets), links closed."""
+    sim = mb.simulate(rigid.system, vehicle.system_params(rigid), rigid_state.q, jnp.zeros(rigid.system.n_dof),
+                      0.0, 1.0, jnp.linspace(0.0, 1.0, 11), inputs=lambda t: jnp.zeros(1),
+                      elements=vehicle.car_elements(rigid), rtol=1e-6, atol=1e-8)
+    assert sim.stop_reason == "completed"
+    assert np.all(np.isfinite(np.asarray(sim.q))) and float(sim.max_residual) < 1e-9
+    assert np.max(np.abs(np.asarray(sim.z[-1]))) < 1e-2  # m/s, rad/s: settled
+    drift = np.asarray(sim.q[-1, :3]) - np.asarray(rigid_state.q[:3])
+    assert np.max(np.abs(drift)) < 1e-3
+
+
 # ---- rates -----------------------------------------------------------------------------------
 
 

@@ -107,7 +107,10 @@ from ._rigs import (
 from ._setup import (
     SetupError as SetupError,
     StaticState as StaticState,
+    SteadyState as SteadyState,
+    chassis_twist as chassis_twist,
     static_equilibrium as static_equilibrium,
+    straight_running as straight_running,
 )
 from ._springs import (
     BUMP_STOP_ROUNDING as BUMP_STOP_ROUNDING,

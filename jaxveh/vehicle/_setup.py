@@ -39,7 +39,8 @@ class StaticState(eqx.Module):
     coordinates; ``twist`` the chassis's static twist (rad: the modal rotation about x
     of the front axle's wishbone pivots A, B, E, F, mean, less the rear axle's; 0 when
     rigid); ``link_forces`` (N, tension positive, the links of Table 6.3 per corner);
-    ``residual`` largest generalised-force residual (N or N m) and ``ok``."""
+    ``constraint_residual`` (m, largest link gap); ``residual`` largest generalised-force
+    residual (N or N m) and ``ok``."""
 
     q: Float[Array, " nq"]
     corner_loads: Float[Array, "4"]
@@ -53,6 +54,7 @@ class StaticState(eqx.Module):
     modes: Float[Array, " nm"]
     twist: Float[Array, ""]
     link_forces: Float[Array, "4 5"]
+    constraint_residual: Float[Array, ""]
     residual: Float[Array, ""]
     ok: Array
 
@@ -111,10 +113,10 @@ def _solve(car: Car, max_steps: int):
     return _state(car, q, dyn, elements, jnp.max(jnp.abs(f)), sol.result == optx.RESULTS.successful)
 
 
-def _state(car, q, dyn, elements, res, converged) -> StaticState:
+def _state(car, q, dyn, elements, res, converged, aux=None) -> StaticState:
     system, kin = car.system, dyn.kinematics
     front, rear, tyres = elements[0], elements[1], elements[2]
-    _, _, _, outs = tyres.evaluate(kin, jnp.zeros((8,)))
+    _, _, _, outs = tyres.evaluate(kin, jnp.zeros((8,)) if aux is None else aux[:8])
     (lf, tf), (rf, _) = front.states(kin)
     (lr, tr), (rr, _) = rear.states(kin)
     lengths, thetas = jnp.concatenate([lf, lr]), jnp.concatenate([tf, tr])
@@ -149,6 +151,7 @@ def _state(car, q, dyn, elements, res, converged) -> StaticState:
         modes=q[6:6 + car.n_modes],
         twist=chassis_twist(car, q[6:6 + car.n_modes]),
         link_forces=jnp.stack(links),
+        constraint_residual=jnp.max(jnp.abs(dyn.projection.phi)),
         residual=res,
         ok=converged & jnp.isfinite(res),
     )
@@ -183,3 +186,95 @@ def static_equilibrium(car: Car, max_steps: int = 32, throw: bool = True) -> Sta
             )
         return state
     return eqx.tree_at(lambda s: s.q, state, eqx.error_if(state.q, ~state.ok, "static set-up failed"))
+
+
+# ---- straight running at speed ------------------------------------------------------------
+
+#: Independent velocities of the straight-running trim: the wheel spins and the chassis's
+#: lateral velocity (unknown), its forward velocity (held); the yaw rate is held at zero.
+_SPINS, _FORWARD, _LATERAL = (1, 3, 5, 7), 8, 9
+#: Auxiliary-state row of the powertrain's error integral: its equation (speed error = 0)
+#: holds identically at the held speed; the forward force balance sets the integral instead.
+_INTEGRAL_ROW = 8
+
+
+class SteadyState(eqx.Module):
+    """Straight running at a constant speed: the :class:`StaticState` of that condition
+    (corner loads now include downforce), the independent velocities ``z`` (wheel spins
+    rad/s, forward speed m/s, the small lateral velocity that comes with the tyres'
+    asymmetric offsets), the ``rack`` travel (m) that holds the car straight against them,
+    auxiliary states ``aux`` (tyre deflections, powertrain), ``drive_torque`` (N m at the
+    rear wheels) and the aero loads ``drag``, ``downforce`` (N)."""
+
+    static: StaticState
+    z: Float[Array, " ndof"]
+    rack: Float[Array, ""]
+    aux: Float[Array, " na"]
+    drive_torque: Float[Array, ""]
+    drag: Float[Array, ""]
+    downforce: Float[Array, ""]
+
+
+def _steady_residual_fn(car: Car):
+    from ._powertrain import ConstantSpeed
+
+    free_q = np.setdiff1d(np.arange(car.system.n_q), _held(car))
+    n = car.system.n_dof
+    free_z = np.asarray(_SPINS + (_LATERAL,))
+    aux_rows = np.setdiff1d(np.arange(10), [_INTEGRAL_ROW])
+
+    def unpack(x, speed, car):
+        nq, nz = free_q.size, free_z.size
+        q = _guess(car).at[free_q].set(x[:nq])
+        z = jnp.zeros((n,), x.dtype).at[free_z].set(x[nq:nq + nz]).at[_FORWARD].set(speed)
+        return q, z, x[nq + nz], x[nq + nz + 1:]
+
+    def residual(x, args):
+        car, speed = args
+        q, z, rack, aux = unpack(x, speed, car)
+        elements = car_elements(car, ConstantSpeed(speed))
+        dyn = dynamics(car.system, system_params(car), q, z, 0.0, lambda t: jnp.reshape(rack, (1,)),
+                       elements=elements, aux=aux)
+        out = jnp.concatenate([dyn.projection.phi, dyn.internal_forces + dyn.external_forces, dyn.aux_dot[aux_rows]])
+        return out, (q, z, rack, aux, dyn, elements)
+
+    def guess(car, speed):
+        spins = speed / car.params.tyres.unloaded_radius
+        aux = jnp.zeros((10,)).at[9].set(speed)
+        return jnp.concatenate([_guess(car)[free_q], spins, jnp.zeros(2), aux])
+
+    return residual, guess
+
+
+@eqx.filter_jit
+def _solve_steady(car: Car, speed, max_steps: int):
+    residual, guess = _steady_residual_fn(car)
+    solver = optx.Newton(rtol=SETUP_RTOL, atol=SETUP_ATOL)
+    sol = optx.root_find(lambda x, a: residual(x, a)[0], solver, guess(car, speed), (car, speed),
+                         max_steps=max_steps, throw=False)
+    f, (q, z, rack, aux, dyn, elements) = residual(sol.value, (car, speed))
+    state = _state(car, q, dyn, elements, jnp.max(jnp.abs(f)), sol.result == optx.RESULTS.successful, aux)
+    torque = elements[4].control(dyn.kinematics, aux[8:])[0]
+    drag, front, rear = car.params.aero.loads(speed)
+    return SteadyState(static=state, z=z, rack=rack, aux=aux, drive_torque=torque, drag=drag, downforce=front + rear)
+
+
+def straight_running(car: Car, speed, max_steps: int = 48, throw: bool = True) -> SteadyState:
+    """The car running straight ahead at ``speed`` (m/s, > 0) on a flat road: every
+    acceleration and state rate zero with the aero loads, rolling tyres (their deflection
+    states), the PID-controlled drive torque that balances drag and rolling resistance, and
+    the small rack travel and lateral velocity with which the driver holds the car straight
+    against the tyres' asymmetric offsets (ply steer, conicity): zero yaw rate. Newton's
+    method on the free coordinates, wheel spins, lateral velocity, rack and auxiliary
+    states. Differentiable in ``car.params`` and ``speed``."""
+    from .._core import check_range
+
+    speed = check_range("speed", speed, low=0.0, low_open=True, what="m/s, straight running needs motion")
+    result = _solve_steady(car, speed, max_steps)
+    ok = result.static.ok
+    if throw and is_concrete(ok) and not bool(ok):
+        raise SetupError(
+            f"straight running at {float(speed):g} m/s not found: largest residual {float(result.static.residual):.3e} "
+            f"after {max_steps} Newton steps; check the powertrain's torque limits against drag and rolling resistance"
+        )
+    return result
