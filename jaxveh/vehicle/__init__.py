@@ -30,6 +30,7 @@ from ._car import (
     sprung_cg as sprung_cg,
     static_corner_loads as static_corner_loads,
     steering as steering,
+    steering_rack as steering_rack,
     system_params as system_params,
     total_mass as total_mass,
     wheel_centres as wheel_centres,
@@ -101,6 +102,7 @@ from ._report import (
 )
 from ._rigs import (
     bump_rig as bump_rig,
+    check_rig as check_rig,
     roll_rig as roll_rig,
     steer_rig as steer_rig,
 )

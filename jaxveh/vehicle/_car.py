@@ -313,11 +313,17 @@ def car_elements(car: Car, speed_target: AbstractSpeedTarget | None = None, road
     return elements
 
 
+def steering_rack(car: Car, steering_wheel_angle):
+    """Rack travel (m, along the chassis y axis) for a steering-wheel angle (rad, positive to
+    the left): ``-rack_ratio`` x angle. The track rods sit behind the axle (Table B.2: L and
+    M at x = -61 mm), so a left turn moves the rack to the right."""
+    return -car.params.rack_ratio * steering_wheel_angle
+
+
 def steering(car: Car, steering_wheel_angle) -> TimeInputs:
     """Rack input from a steering-wheel angle law ``steering_wheel_angle(t)`` (rad, positive
-    to the left): rack = ``rack_ratio`` x angle."""
-    ratio = car.params.rack_ratio
-    return TimeInputs(lambda t: ratio * steering_wheel_angle(t))
+    to the left), see :func:`steering_rack`."""
+    return TimeInputs(lambda t: steering_rack(car, steering_wheel_angle(t)))
 
 
 # ---- loading --------------------------------------------------------------------------------

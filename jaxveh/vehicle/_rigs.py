@@ -28,8 +28,8 @@ import numpy as np
 import optimistix as optx
 
 from .._core import GRAVITY
-from ..multibody import body_poses, constraints, energy, kinematics, marker_positions
-from ._car import CORNERS, Car, car_elements, design_coordinates, system_params
+from ..multibody import body_poses, constraints, kinematics, marker_positions
+from ._car import CORNERS, Car, car_elements, design_coordinates, steering_rack, system_params
 from ._corner import WHEEL_CENTRE_HEIGHT
 from ._setup import StaticState
 
@@ -93,9 +93,14 @@ def _suspension_forces(car, sp, q, rack, axles=AXLES):
 
 
 def _configuration(car, sp, q_ref, set_held, flexible):
-    """``q(s)`` for the rig coordinate ``s``: held coordinates from ``set_held(q_ref, s)`` (a
-    function returning ``(q_guess, rack)``), links closed, modes in equilibrium if
-    ``flexible``."""
+    """``(solve, closed)`` for the rig coordinate ``s``: ``closed(s, p)`` holds the
+    coordinates ``set_held(q_ref, s)`` gives (a function returning ``(q_guess, rack)``) and
+    the modes ``p`` and closes the links; ``solve(s)`` also finds the modes in equilibrium
+    when ``flexible`` (else keeps those of ``q_ref``). Both return ``(q, worst, rack)``.
+
+    Loads on a held coordinate are partial derivatives at fixed modes: where the modes are in
+    equilibrium, their own virtual work vanishes (so nothing is differentiated through the
+    modal solve)."""
     m = car.n_modes
     modal_rows = np.arange(6, 6 + m)
 
@@ -106,20 +111,21 @@ def _configuration(car, sp, q_ref, set_held, flexible):
         return _assemble(car, sp, q_guess, rack) + (rack,)
 
     if not (flexible and m):
-        return lambda s: closed(s, q_ref[modal_rows])
+        return (lambda s: closed(s, q_ref[modal_rows])), closed
 
-    stiffness = sp.bodies[0].modal.stiffness_matrix()
+    chassis = sp.bodies[0]
+    stiffness = chassis.modal.stiffness_matrix()
 
     def modal_loads(p, s):
-        """Generalised forces on the modes (N per modal unit) of gravity and the suspension,
-        by virtual work along the modes with the links closed (the elastic force apart)."""
+        """Generalised forces on the modes (N per modal unit) of the suspension (virtual work
+        along the modes with the links closed) and of the chassis's own weight (the uprights'
+        weight does no work: their heights are held); the elastic force apart."""
         q, _, rack = closed(s, p)
         u = jnp.reshape(rack, (1,))
         forces = _suspension_forces(car, sp, q, rack)
         jac_x = jax.jacfwd(lambda pp: marker_positions(car.system, sp, closed(s, pp)[0], u))(p)
-        rest = jnp.zeros((car.system.n_y,))
-        grad_g = jax.grad(lambda pp: energy(car.system, sp, closed(s, pp)[0], rest)["gravity"])(p)
-        return jnp.einsum("pi,pij->j", forces, jac_x) - grad_g
+        g_body = body_poses(car.system, sp, q)[0][1].T @ sp.gravity
+        return jnp.einsum("pi,pij->j", forces, jac_x) + chassis.gravity(g_body, p, car.system.options)[6:]
 
     def solve(s):
         # K p = f(p) by Newton's method (the loads' dependence on p through the geometry is
@@ -137,7 +143,7 @@ def _configuration(car, sp, q_ref, set_held, flexible):
         balanced = change <= MODAL_TOL * (1.0 + jnp.max(jnp.abs(p)))
         return q, jnp.where((worst < 0) & ~balanced, MODES_UNBALANCED, worst), rack
 
-    return solve
+    return solve, closed
 
 
 
@@ -173,13 +179,16 @@ def _reference(car: Car, state: StaticState | None):
     return q
 
 
-def _pad_loads(car, sp, config, pads, s):
-    """Vertical pad loads (N) at the wheels whose heights the rig coordinates ``s`` set."""
-    mu = jnp.stack([car.params.vehicle.unsprung_front.body.mass] * 2 + [car.params.vehicle.unsprung_rear.body.mass] * 2)
-    q, _, rack = config(s)
+def _pad_loads(car, sp, q, closed, pads, s):
+    """Vertical pad loads (N) at the wheels whose heights the rig coordinates ``s`` set, in
+    the configuration ``q`` (its modes held: see :func:`_configuration`)."""
+    v = car.params.vehicle
+    mu = jnp.stack([v.unsprung_front.body.mass] * 2 + [v.unsprung_rear.body.mass] * 2)
+    p = q[6:6 + car.n_modes]
+    rack = jnp.zeros(())
     forces = _suspension_forces(car, sp, q, rack)
     u = jnp.reshape(rack, (1,))
-    jac = jax.jacfwd(lambda ss: marker_positions(car.system, sp, config(ss)[0], u))(s)
+    jac = jax.jacfwd(lambda ss: marker_positions(car.system, sp, closed(ss, p)[0], u))(s)
     return mu[np.asarray(pads)] * GRAVITY - jnp.einsum("pi,pij->j", forces, jac)
 
 
@@ -192,7 +201,7 @@ def _bump(car: Car, travel, axle: str, state, flexible: bool):
     def held(q_ref, s):
         return q_ref.at[rows].add(s), jnp.zeros(())
 
-    config = _configuration(car, sp, _reference(car, state), held, flexible)
+    config, closed = _configuration(car, sp, _reference(car, state), held, flexible)
 
     def point(h):
         s = jnp.stack([h, h])
@@ -207,7 +216,7 @@ def _bump(car: Car, travel, axle: str, state, flexible: bool):
             "track": m["centre"][left, 1] - m["centre"][right, 1],
             "wheel_centre_x": m["centre"][np.asarray(pads), 0],
             "wheel_centre_y": m["centre"][np.asarray(pads), 1],
-            "fz": _pad_loads(car, sp, config, pads, s),
+            "fz": _pad_loads(car, sp, q, closed, pads, s),
             "worst": worst,
         }
 
@@ -247,9 +256,9 @@ def _steer(car: Car, angles, state, flexible: bool):
     sp = system_params(car)
 
     def held(q_ref, s):
-        return q_ref, car.params.rack_ratio * s
+        return q_ref, steering_rack(car, s)
 
-    config = _configuration(car, sp, _reference(car, state), held, flexible)
+    config, _ = _configuration(car, sp, _reference(car, state), held, flexible)
     v = car.params.vehicle
 
     def point(angle):
@@ -291,12 +300,13 @@ def _roll(car: Car, angles, state, flexible: bool, axis_height):
         origin = jnp.stack([jnp.zeros_like(s), axis_height * jnp.sin(s), axis_height * (1.0 - jnp.cos(s))])
         return q_ref.at[roll_row].add(s).at[:3].add(origin), jnp.zeros(())
 
-    config = _configuration(car, sp, _reference(car, state), held, flexible)
+    config, closed = _configuration(car, sp, _reference(car, state), held, flexible)
 
     def moments(phi):
         q, _, rack = config(phi)
         u = jnp.reshape(rack, (1,))
-        dx = jax.jacfwd(lambda s: marker_positions(car.system, sp, config(s)[0], u))(phi)
+        p = q[6:6 + car.n_modes]
+        dx = jax.jacfwd(lambda s: marker_positions(car.system, sp, closed(s, p)[0], u))(phi)
         return jnp.stack([-jnp.sum(_suspension_forces(car, sp, q, rack, (axle,)) * dx) for axle in AXLES])
 
     def point(phi):
