@@ -1,6 +1,6 @@
 """Markdown documentation of the data-file schemas (written to ``docs/data.md``)."""
 
-from . import _appendix_a, _appendix_b
+from . import _appendix_a, _appendix_b, _car_file
 from ._schema import schema_markdown
 
 HEADER = """# Vehicle data files
@@ -37,6 +37,22 @@ must keep the inertia tensor positive definite (|Jxz| < sqrt(Jxx Jzz)).
 """
 
 
+CAR = """
+
+## The car file (`car.toml`)
+
+The 14-DOF car of `jaxveh.vehicle.load_car`: every Appendix B section above (same keys,
+units and checks) plus the sections below, the car's data beyond the thesis's tables
+(choices documented in `docs/vehicle.md`). `[files]` names the tyre file of each axle and
+the chassis frame file: a shipped name (`fsae_20x7_13.tir`, `fsae_2009_frame.toml`) or a
+path, relative paths resolved against the car file's folder; a missing file raises
+`ParameterError` naming the key. Table B.4's `kz`, `cz` and relaxation lengths replace the
+tyre file's. The right corners mirror the left; the springs' free lengths are not data: they
+are set so that the car rests at the design position (`rest_spring_preloads`).
+
+"""
+
+
 def render() -> str:
     """The full Markdown text of ``docs/data.md``."""
     b_sections = {
@@ -45,4 +61,7 @@ def render() -> str:
         "unsprung_front / unsprung_rear": _appendix_b.UNSPRUNG,
         "tyre": _appendix_b.TYRE,
     }
-    return HEADER + schema_markdown(_appendix_a.SCHEMA) + MIDDLE + schema_markdown(b_sections) + "\n"
+    car = {"suspension_front / suspension_rear": _car_file.SUSPENSION, "steering": _car_file.STEERING,
+           "aero": _car_file.AERO, "powertrain": _car_file.POWERTRAIN, "chassis": _car_file.CHASSIS}
+    return (HEADER + schema_markdown(_appendix_a.SCHEMA) + MIDDLE + schema_markdown(b_sections) + CAR
+            + schema_markdown(car) + "\n")

@@ -39,6 +39,9 @@ RIG_ITERATIONS, RIG_ATOL = 24, 1e-10
 #: Newton steps of the modal equilibrium of a flexible chassis, and the relative
 #: change of the modal coordinates accepted after them.
 MODAL_ITERATIONS, MODAL_TOL = 4, 1e-9
+#: Roll step (rad) of the central difference that gives the roll stiffness of a flexible
+#: chassis (whose modes are re-balanced at every angle); exact derivative otherwise.
+ROLL_STEP = 1e-4
 #: Code of a rig point whose links closed but whose modes did not balance.
 MODES_UNBALANCED = -2
 AXLES = ("front", "rear")
@@ -312,7 +315,11 @@ def _roll(car: Car, angles, state, flexible: bool, axis_height):
     def point(phi):
         q, worst, _ = config(phi)
         m = _wheel_measures(car, sp, q, road_axes=True)
-        moment, stiffness = jax.jvp(moments, (phi,), (jnp.ones_like(phi),))
+        if flexible and car.n_modes:  # central difference: no derivative through the modal solve
+            moment = moments(phi)
+            stiffness = (moments(phi + ROLL_STEP) - moments(phi - ROLL_STEP)) / (2.0 * ROLL_STEP)
+        else:
+            moment, stiffness = jax.jvp(moments, (phi,), (jnp.ones_like(phi),))
         return {"camber": m["camber"], "toe": m["toe"], "moment": moment, "stiffness": stiffness, "worst": worst}
 
     return jax.vmap(point)(angles)
