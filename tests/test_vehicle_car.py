@@ -274,3 +274,11 @@ def test_vehicle_info_lists_chassis_modes(flexible):
 def test_vehicle_info_refuses_bad_modes():
     result = CliRunner().invoke(app, ["vehicle", "info", "--modes", "40", "--json"])
     assert result.exit_code == 2 and "modes" in result.output
+
+
+def test_force_element_builders_name_unknown_points(rigid):
+    with pytest.raises(ValueError, match="unknown point 'front_left.nowhere'"):
+        vehicle.TyreContact.on(rigid.system, {"fl": ("front_left.nowhere", "front_left.W")}, rigid.params.tyres)
+    with pytest.raises(ValueError, match="unknown point 'chassis.wing'"):
+        vehicle.AeroLoads.on(rigid.system, "chassis", "chassis.cg", "chassis.wing", "chassis.aero_rear",
+                             rigid.params.aero)

@@ -146,7 +146,8 @@ def test_flexible_rigs_tend_to_rigid_with_stiff_modes(rigid, bump_front):
 
 def test_unreachable_travel_names_the_link(rigid):
     r = vehicle.bump_rig(rigid, jnp.asarray([0.0, 0.0, 0.0, 0.0, 0.6]), "front")
-    with pytest.raises(mb.AssemblyError, match=r"sweep point 4 of 5: link front_(left|right)\.\w+\[length\] does not close"):
+    message = r"sweep point 4 of 5: link front_(left|right)\.\w+\[length\] does not close"
+    with pytest.raises(mb.AssemblyError, match=message):
         vehicle.check_rig(rigid, "bump rig", r)
 
 

@@ -73,12 +73,6 @@ def zero_forces(kin: Kinematics, n_aux: int = 0) -> ElementForces:
     return ElementForces(forces=zeros, torques=zeros, aux_dot=jnp.zeros((n_aux,), kin.x.dtype))
 
 
-def _point_index(system: System, name: str) -> int:
-    if name not in system.point_names:
-        raise ValueError(f"unknown point {name!r}; points: {list(system.point_names)}")
-    return system.point_index(name)
-
-
 class SpringDamper(AbstractForceElement):
     """Linear spring-damper between points ``i`` and ``j`` along their line: tension
     ``k (l - l0) + c l_dot + preload`` (N) pulls them together. ``k`` N/m, ``c`` Ns/m,
@@ -94,7 +88,7 @@ class SpringDamper(AbstractForceElement):
 
     @classmethod
     def between(cls, system: System, p: str, q: str, k, c, l0, preload=0.0) -> "SpringDamper":
-        return cls(_point_index(system, p), _point_index(system, q), k, c, l0, preload)
+        return cls(system.point_index(p), system.point_index(q), k, c, l0, preload)
 
     def __call__(self, kin, aux, system):
         d = kin.x[self.j] - kin.x[self.i]
@@ -124,7 +118,7 @@ class Bushing(AbstractForceElement):
 
     @classmethod
     def between(cls, system: System, p: str, q: str, k, c, kr=(0.0, 0.0, 0.0), cr=(0.0, 0.0, 0.0)) -> "Bushing":
-        return cls(_point_index(system, p), _point_index(system, q), k, c, kr, cr)
+        return cls(system.point_index(p), system.point_index(q), k, c, kr, cr)
 
     def __call__(self, kin, aux, system):
         a = kin.point_rotations[self.i]
@@ -160,7 +154,7 @@ class TorsionSpring(AbstractForceElement):
     @classmethod
     def between(cls, system: System, p: str, q: str, axis, kt, ct, phi0=0.0) -> "TorsionSpring":
         axis = np.asarray(axis, dtype=np.float64)
-        return cls(_point_index(system, p), _point_index(system, q), axis / np.linalg.norm(axis), kt, ct, phi0)
+        return cls(system.point_index(p), system.point_index(q), axis / np.linalg.norm(axis), kt, ct, phi0)
 
     def __call__(self, kin, aux, system):
         a = kin.point_rotations[self.i]

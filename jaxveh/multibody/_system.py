@@ -185,17 +185,25 @@ class System(eqx.Module):
 
     def q_index(self, body: str, coordinate: str) -> int:
         """Index in ``q`` of ``coordinate`` of ``body`` (names as in :attr:`q_names`)."""
-        return self.q_names.index(f"{body}.{coordinate}")
+        return _lookup(self.q_names, f"{body}.{coordinate}", "coordinate")
 
     def y_index(self, body: str, velocity: str) -> int:
-        return self.y_names.index(f"{body}.{velocity}")
+        """Index in ``y`` of ``velocity`` of ``body`` (names as in :attr:`y_names`)."""
+        return _lookup(self.y_names, f"{body}.{velocity}", "velocity")
 
     def point_index(self, name: str) -> int:
-        return self.point_names.index(name)
+        """Index of the point ``name``; ``ValueError`` listing the points if there is none."""
+        return _lookup(self.point_names, name, "point")
 
     def with_options(self, options: FlexOptions) -> "System":
         """The same system with other flexible-body simplifications (Table 7.2)."""
         return dataclasses.replace(self, options=options)
+
+
+def _lookup(names: tuple[str, ...], name: str, kind: str) -> int:
+    if name not in names:
+        raise ValueError(f"unknown {kind} {name!r}; the system has: {', '.join(names)}")
+    return names.index(name)
 
 
 def _q_labels(system: System, i: int) -> list[str]:
