@@ -57,11 +57,16 @@ def _axle(axle: str) -> str:
 
 def installation_ratios(axle: str = "front", data=None, bump=0.0) -> InstallationRatios:
     """Installation ratios of the left corner of ``axle`` at wheel-centre travel ``bump``
-    (m, positive up relative to the chassis), zero rack."""
+    (m, positive up relative to the chassis), zero rack. Compiled once per axle."""
     data = load_vehicle_data() if data is None else data
-    hp = (data.hard_points_front if _axle(axle) == "front" else data.hard_points_rear).points
     # the structure from the shipped data, the (possibly traced) hard points as leaves
-    system, params = quarter_car(None, axle)
+    system, params = quarter_car(None, _axle(axle))
+    return _installation_ratios(system, params, axle, data, jnp.asarray(bump, jnp.float64))
+
+
+@eqx.filter_jit
+def _installation_ratios(system, params, axle: str, data, bump) -> InstallationRatios:
+    hp = (data.hard_points_front if axle == "front" else data.hard_points_rear).points
     wheel_centre = quarter_car_wheel_centre(data, axle)
     params = quarter_car_with_hard_points(system, params, hp, wheel_centre)
     xa, xb, xc, xd, xp, xq, xr, xs, xt = (hp[HARD_POINT_NAMES.index(n)] for n in "ABCDPQRST")
@@ -78,7 +83,6 @@ def installation_ratios(axle: str = "front", data=None, bump=0.0) -> Installatio
     def first(z):
         return jax.jvp(chain, (z,), (jnp.ones_like(z),))
 
-    bump = jnp.asarray(bump, jnp.float64)
     ((length, theta), (d_length, d_theta)), (_, (dd_length, _)) = jax.jvp(first, (bump,), (jnp.ones_like(bump),))
     return InstallationRatios(spring=d_length, spring_curvature=dd_length, rocker=d_theta, spring_length=length,
                               rocker_angle=theta)
