@@ -282,3 +282,33 @@ def test_force_element_builders_name_unknown_points(rigid):
     with pytest.raises(ValueError, match="unknown point 'chassis.wing'"):
         vehicle.AeroLoads.on(rigid.system, "chassis", "chassis.cg", "chassis.wing", "chassis.aero_rear",
                              rigid.params.aero)
+
+
+def test_new_parameter_values_never_retrace(rigid):
+    """Every number is a leaf: the car's equations trace once for any values (a changed hard
+    point, spring table, anti-roll bar, mass or tyre coefficient)."""
+
+    s = rigid.system
+    rows = np.asarray([s.q_index(b, "z") for b in ("chassis",) + tuple(f"{c}.upright" for c in vehicle.CORNERS)])
+    lowered = rigid.q_design.at[rows].add(-0.005)  # the tyres touch the road; loops stay closed
+
+    @eqx.filter_jit
+    @eqx.debug.assert_max_traces(max_traces=1)
+    def accelerations(car):
+        sp = vehicle.system_params(car)
+        dyn = mb.dynamics(car.system, sp, lowered, jnp.zeros(car.system.n_dof), 0.0, lambda t: jnp.zeros(1),
+                          elements=vehicle.car_elements(car), aux=jnp.full((10,), 1e-3))
+        return dyn.z_dot
+
+    p = rigid.params
+    edits = [
+        lambda c: eqx.tree_at(lambda c: c.params.vehicle.hard_points_front.points, c,
+                              p.vehicle.hard_points_front.points.at[6, 2].add(0.01)),
+        lambda c: eqx.tree_at(lambda c: c.params.springs.spring_force, c, p.springs.spring_force * 1.1),
+        lambda c: eqx.tree_at(lambda c: c.params.arb_rates, c, p.arb_rates * 2.0),
+        lambda c: eqx.tree_at(lambda c: c.params.vehicle.sprung.mass, c, p.vehicle.sprung.mass + 10.0),
+        lambda c: eqx.tree_at(lambda c: c.params.tyres.pdy1, c, p.tyres.pdy1 * 0.9),
+    ]
+    base = accelerations(rigid)
+    for edit in edits:
+        assert not np.allclose(accelerations(edit(rigid)), base)

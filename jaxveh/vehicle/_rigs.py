@@ -81,6 +81,11 @@ def _assemble(car, sp, q_guess, rack):
     return q, jnp.where(ok, -1, jnp.argmax(jnp.where(jnp.isfinite(gaps), gaps, jnp.inf)))
 
 
+def _gap(car, sp, q, rack):
+    """Largest constraint residual (m) of a rig configuration."""
+    return jnp.max(jnp.abs(constraints(car.system, sp, q, jnp.reshape(rack, (1,)))))
+
+
 def _suspension_forces(car, sp, q, rack, axles=AXLES):
     """Forces (np, 3; N) of the chosen axles' push-rod suspensions at rest in ``q``."""
     system = car.system
@@ -208,7 +213,7 @@ def _bump(car: Car, travel, axle: str, state, flexible: bool):
 
     def point(h):
         s = jnp.stack([h, h])
-        q, worst, _ = config(s)
+        q, worst, rack = config(s)
         m = _wheel_measures(car, sp, q, road_axes=False)
         w0 = design_coordinates(car)
         left, right = pads
@@ -221,6 +226,7 @@ def _bump(car: Car, travel, axle: str, state, flexible: bool):
             "wheel_centre_y": m["centre"][np.asarray(pads), 1],
             "fz": _pad_loads(car, sp, q, closed, pads, s),
             "worst": worst,
+            "gap": _gap(car, sp, q, rack),
         }
 
     return jax.vmap(point)(travel)
@@ -231,7 +237,8 @@ def bump_rig(car: Car, travel, axle: str = "front", state: StaticState | None = 
     positive up) relative to the level chassis. Returns arrays over the travel with a
     trailing axis (left, right) where per wheel: ``travel`` (m, wheel centre relative to the
     chassis from the design position), ``camber``, ``toe`` (rad), ``wheel_centre_x``,
-    ``wheel_centre_y`` (m, chassis axes), ``fz`` (N, pad load); ``track`` (m) and ``worst``
+    ``wheel_centre_y`` (m, chassis axes), ``fz`` (N, pad load); ``track`` (m), ``gap`` (m, the largest link
+    residual) and ``worst``
     (-1 where every link closed and the modes balanced; else the constraint row with the
     largest gap, or ``MODES_UNBALANCED``; :func:`check_rig` raises on them)."""
     return _bump(car, jnp.asarray(travel, jnp.float64), axle, state, flexible)
@@ -265,7 +272,7 @@ def _steer(car: Car, angles, state, flexible: bool):
     v = car.params.vehicle
 
     def point(angle):
-        q, worst, _ = config(angle)
+        q, worst, rack = config(angle)
         m = _wheel_measures(car, sp, q, road_axes=False)
         left, right = m["steer"][0], m["steer"][1]
         inner, outer = jnp.where(angle >= 0, left, -right), jnp.where(angle >= 0, right, -left)
@@ -279,6 +286,7 @@ def _steer(car: Car, angles, state, flexible: bool):
             "scrub_radius": jnp.stack([_scrub_radius(car, sp, q, 0), _scrub_radius(car, sp, q, 1)]),
             "ackermann": jnp.where(jnp.abs(angle) < 1e-6, jnp.nan, ackermann),
             "worst": worst,
+            "gap": _gap(car, sp, q, rack),
         }
 
     return jax.vmap(point)(angles)
@@ -313,14 +321,15 @@ def _roll(car: Car, angles, state, flexible: bool, axis_height):
         return jnp.stack([-jnp.sum(_suspension_forces(car, sp, q, rack, (axle,)) * dx) for axle in AXLES])
 
     def point(phi):
-        q, worst, _ = config(phi)
+        q, worst, rack = config(phi)
         m = _wheel_measures(car, sp, q, road_axes=True)
         if flexible and car.n_modes:  # central difference: no derivative through the modal solve
             moment = moments(phi)
             stiffness = (moments(phi + ROLL_STEP) - moments(phi - ROLL_STEP)) / (2.0 * ROLL_STEP)
         else:
             moment, stiffness = jax.jvp(moments, (phi,), (jnp.ones_like(phi),))
-        return {"camber": m["camber"], "toe": m["toe"], "moment": moment, "stiffness": stiffness, "worst": worst}
+        return {"camber": m["camber"], "toe": m["toe"], "moment": moment, "stiffness": stiffness, "worst": worst,
+                "gap": _gap(car, sp, q, rack)}
 
     return jax.vmap(point)(angles)
 
@@ -346,8 +355,10 @@ def check_rig(car: Car, name: str, result: dict) -> dict:
     bad = np.flatnonzero(worst != -1)
     if bad.size:
         code = int(worst[bad[0]])
+        gap = float(np.asarray(result["gap"]).ravel()[bad[0]])
         why = ("the chassis modes did not balance" if code == MODES_UNBALANCED else
-               f"link {car.system.constraint_names[code]} does not close (its gap exceeds {RIG_ATOL:g} m)")
+               f"link {car.system.constraint_names[code]} does not close (largest gap {gap:.3e} m, tolerance "
+               f"{RIG_ATOL:g} m)")
         raise AssemblyError(f"{name}: cannot assemble the car at sweep point {int(bad[0])} of {worst.size}: {why}; "
                             "reduce the range or check the hard points")
     return result
