@@ -33,13 +33,16 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
+from .. import fe
 from .._core import GRAVITY, ParameterError, as_float
 from ..multibody import FlexibleBody, RigidBody, System, SystemBuilder, SystemParams, TimeInputs
 from ..params import HARD_POINT_NAMES, CarFile, VehicleData, hard_points_vehicle_frame, read_car_file
+from ..tyre import fsae_tir_path, read_tir, stack_tyres
 from ._aero import AeroLoads, AeroMap, aero_map_from_coefficients
 from ._contact import AbstractRoad, FlatRoad, TyreContact
 from ._corner import QUARTER_CAR_LINKS, WHEEL_CENTRE_HEIGHT
 from ._powertrain import AbstractSpeedTarget, ConstantSpeed, Powertrain, SpeedPID
+from ._rates import installation_ratios
 from ._springs import SpringDamperLaw, linear_spring_damper
 from ._suspension import pushrod_suspension
 
@@ -330,8 +333,6 @@ def steering(car: Car, steering_wheel_angle) -> TimeInputs:
 
 
 def _tyre(name: str, key: str, where: str, vehicle: VehicleData):
-    from ..tyre import fsae_tir_path, read_tir
-
     path = fsae_tir_path() if name == fsae_tir_path().name else Path(name)
     if not path.is_file():
         raise ParameterError(f"{where} [files].{key}: tyre file {name!r} does not exist")
@@ -342,8 +343,6 @@ def _tyre(name: str, key: str, where: str, vehicle: VehicleData):
 
 
 def _frame(name: str, where: str):
-    from .. import fe
-
     if name == "fsae_2009_frame.toml":
         return fe.load_frame()
     if not Path(name).is_file():
@@ -376,9 +375,6 @@ def load_car(path: str | Path | None = None, modes: int = 6, form: str = "librar
     The springs' free lengths are set so that the car at rest on a flat road has every
     suspension at its design position (Tables B.2/B.3), see :func:`rest_spring_preloads`.
     """
-    from .. import fe
-    from ..tyre import stack_tyres
-
     if form != "library":
         raise ParameterError(f"form = {form!r} is not available: allowed 'library'")
     modes = _check_modes(modes)
@@ -418,8 +414,6 @@ def rest_spring_preloads(car: Car) -> Float[Array, "4"]:
     ``(0, 0, h_cg)``, all loads vertical) less the unsprung weight, carried to the spring by
     the installation ratio, ``F_s = (W_c - m_u g) / (-dl_s/dz)`` (virtual work; the contact
     point moves with the wheel centre at zero camber)."""
-    from ._rates import installation_ratios
-
     v = car.params.vehicle
     loads = static_corner_loads(v)
     mu = _unsprung_masses(v)

@@ -11,8 +11,9 @@ import math
 import jax
 import jax.numpy as jnp
 
-from ._car import CORNER_KEYS, Car, total_mass
+from ._car import CORNER_KEYS, Car, design_spring_lengths, total_mass
 from ._rates import AxleRates, axle_rates, corner_sprung_masses, installation_ratios, roll_stiffness_distribution
+from ._rigs import bump_rig, check_rig, roll_rig, steer_rig
 from ._setup import StaticState, static_equilibrium
 
 AXLES = ("front", "rear")
@@ -21,8 +22,6 @@ AXLES = ("front", "rear")
 def spring_at_design(car: Car):
     """``(rate N/m, force N)`` of each corner's spring at its design length (the spring
     table's slope and value there; compression positive)."""
-    from ._car import design_spring_lengths
-
     lengths = design_spring_lengths(car.params.vehicle)
 
     def one(law, length):
@@ -101,8 +100,6 @@ def bump_report(car: Car, travel_mm, flexible: bool = True, state=None) -> dict:
     """Bump rig of both axles as plain lists, the left wheel of each (contract of
     ``jaxveh rig bump --json``): ``travel_mm``, ``camber_deg``, ``toe_deg``, ``track_mm``,
     ``fz_n``, ``wheel_centre_x_mm``, ``wheel_centre_y_mm``."""
-    from ._rigs import bump_rig, check_rig
-
     out = {}
     for axle in AXLES:
         r = check_rig(car, f"bump rig, {axle} axle",
@@ -124,8 +121,6 @@ def steer_report(car: Car, steering_wheel_deg, flexible: bool = True, state=None
     ``left_deg``, ``right_deg`` (road-wheel angles, positive left), ``left_camber_deg``,
     ``right_camber_deg``, ``track_mm``, ``scrub_radius_mm`` (left wheel), ``ackermann_pct``
     (null at zero steer, where it is undefined)."""
-    from ._rigs import check_rig, steer_rig
-
     angles = jnp.asarray(steering_wheel_deg, jnp.float64)
     r = check_rig(car, "steer rig", steer_rig(car, jnp.radians(angles), state, flexible))
     deg = 180.0 / math.pi
@@ -147,8 +142,6 @@ def roll_report(car: Car, roll_deg, flexible: bool = True, state=None) -> dict:
     """Roll rig as plain lists: ``roll_deg``; per axle the left wheel's ``camber_deg`` and
     ``toe_deg`` (road axes: roll camber, roll steer), the right wheel's, and the axle's
     ``roll_moment_nm``; ``roll_stiffness_nm_per_deg`` per axle at zero roll."""
-    from ._rigs import check_rig, roll_rig
-
     angles = jnp.asarray(roll_deg, jnp.float64)
     r = check_rig(car, "roll rig", roll_rig(car, jnp.radians(angles), state, flexible))
     zero = roll_rig(car, jnp.zeros((1,)), state, flexible)

@@ -28,7 +28,7 @@ import numpy as np
 import optimistix as optx
 
 from .._core import GRAVITY
-from ..multibody import body_poses, constraints, kinematics, marker_positions
+from ..multibody import AssemblyError, body_poses, constraints, kinematics, marker_positions
 from ._car import CORNERS, Car, car_elements, design_coordinates, steering_rack, system_params
 from ._corner import WHEEL_CENTRE_HEIGHT
 from ._setup import StaticState
@@ -349,8 +349,6 @@ def roll_rig(car: Car, roll, state: StaticState | None = None, flexible: bool = 
 def check_rig(car: Car, name: str, result: dict) -> dict:
     """Raise :class:`jaxveh.multibody.AssemblyError` naming the first failed point of a rig
     sweep and why (the link and its gap, or unbalanced modes); return ``result``."""
-    from ..multibody import AssemblyError
-
     worst = np.asarray(result["worst"]).ravel()
     bad = np.flatnonzero(worst != -1)
     if bad.size:

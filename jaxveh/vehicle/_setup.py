@@ -15,10 +15,11 @@ import numpy as np
 import optimistix as optx
 from jaxtyping import Array, Float
 
-from .._core import is_concrete
+from .._core import check_range, is_concrete
 from ..multibody import MultibodyError, dynamics, rotation_matrix
 from ._car import CORNERS, Car, car_elements, design_coordinates, static_corner_loads, system_params
 from ._corner import WHEEL_CENTRE_HEIGHT
+from ._powertrain import ConstantSpeed
 
 #: Newton stops when the step (m, rad, modal units) is below ``atol + rtol |x|`` and the
 #: generalised forces (N, N m) below ``atol``.
@@ -216,8 +217,6 @@ class SteadyState(eqx.Module):
 
 
 def _steady_residual_fn(car: Car):
-    from ._powertrain import ConstantSpeed
-
     free_q = np.setdiff1d(np.arange(car.system.n_q), _held(car))
     n = car.system.n_dof
     free_z = np.asarray(_SPINS + (_LATERAL,))
@@ -267,8 +266,6 @@ def straight_running(car: Car, speed, max_steps: int = 48, throw: bool = True) -
     against the tyres' asymmetric offsets (ply steer, conicity): zero yaw rate. Newton's
     method on the free coordinates, wheel spins, lateral velocity, rack and auxiliary
     states. Differentiable in ``car.params`` and ``speed``."""
-    from .._core import check_range
-
     speed = check_range("speed", speed, low=0.0, low_open=True, what="m/s, straight running needs motion")
     result = _solve_steady(car, speed, max_steps)
     ok = result.static.ok
