@@ -17,7 +17,9 @@ from ._dynamics import (
     body_torque as body_torque,
     energy as energy,
     internal_forces as internal_forces,
+    internal_forces_at as internal_forces_at,
     mass_matrix as mass_matrix,
+    mass_matrix_at as mass_matrix_at,
     point_force as point_force,
 )
 from ._errors import (
@@ -35,6 +37,7 @@ from ._forces import (
     SpringDamper as SpringDamper,
     TorsionSpring as TorsionSpring,
     aux_names as aux_names,
+    element_forces as element_forces,
     generalised_forces as generalised_forces,
     kinematics as kinematics,
     zero_forces as zero_forces,
