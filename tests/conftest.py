@@ -1,14 +1,16 @@
 """Test configuration: float64, strict dtype promotion, rank promotion raises.
 
 Every compiled XLA executable holds a few memory mappings of JIT code. A long-lived test
-worker that compiles thousands of functions reaches the kernel's `vm.max_map_count`
-(65530 by default), and the next compile then segfaults inside XLA's CPU compiler. Each
-test module therefore drops JAX's compilation caches when it ends, which frees the
-executables it compiled (module-scoped fixtures such as a compiled car are torn down
-before this one).
+worker that compiles thousands of functions reaches the kernel's ``vm.max_map_count``
+(65530 by default), and the next compile then segfaults inside XLA's CPU compiler (seen in
+CI). So JAX's compilation caches are dropped, which frees the executables, when a test
+module ends (its module-scoped fixtures, a compiled car, are torn down first) and, within a
+long module, after any test that leaves the process above half the limit (later tests of
+that module then compile again: slower, never wrong).
 """
 
 import gc
+from pathlib import Path
 
 import jax
 import pytest
@@ -19,10 +21,32 @@ jax.config.update("jax_enable_x64", True)
 jax.config.update("jax_numpy_dtype_promotion", "strict")
 jax.config.update("jax_numpy_rank_promotion", "raise")
 
+_MAPS, _MAX_MAPS = Path("/proc/self/maps"), Path("/proc/sys/vm/max_map_count")
 
-@pytest.fixture(autouse=True, scope="module")
-def _release_compiled_code():
-    """Free the module's compiled executables (and their memory mappings) when it ends."""
-    yield
+
+def _release():
     jax.clear_caches()
     gc.collect()
+
+
+def _near_map_limit() -> bool:
+    if not (_MAPS.exists() and _MAX_MAPS.exists()):
+        return False
+    with _MAPS.open("rb") as f:
+        count = sum(1 for _ in f)
+    return count > int(_MAX_MAPS.read_text()) // 2
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _release_compiled_code_per_module():
+    """Free the module's compiled executables (and their memory mappings) when it ends."""
+    yield
+    _release()
+
+
+@pytest.fixture(autouse=True)
+def _release_compiled_code_near_limit():
+    """Free compiled executables after a test that leaves the process near the map limit."""
+    yield
+    if _near_map_limit():
+        _release()
