@@ -7,6 +7,10 @@ CI). So JAX's compilation caches are dropped, which frees the executables, when 
 module ends (its module-scoped fixtures, a compiled car, are torn down first) and, within a
 long module, after any test that leaves the process above half the limit (later tests of
 that module then compile again: slower, never wrong).
+
+Compiled executables also go to a persistent compilation cache (``.pytest_cache/jax``,
+entries that took over a second to compile): a later module, worker or run that compiles
+the same program (the car's static set-up, say) loads it instead.
 """
 
 import gc
@@ -20,6 +24,8 @@ import jaxveh  # noqa: F401  (enables float64)
 jax.config.update("jax_enable_x64", True)
 jax.config.update("jax_numpy_dtype_promotion", "strict")
 jax.config.update("jax_numpy_rank_promotion", "raise")
+jax.config.update("jax_compilation_cache_dir", str(Path(__file__).resolve().parents[1] / ".pytest_cache" / "jax"))
+jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 _MAPS, _MAX_MAPS = Path("/proc/self/maps"), Path("/proc/sys/vm/max_map_count")
 

@@ -102,11 +102,35 @@ def link_residual(w, geometry: CornerGeometry, travel, rack, pivots):
     return (jnp.sum(d * d, axis=1) - geometry.lengths**2) / (2.0 * geometry.lengths)
 
 
+def solve_small(a, b):
+    """``a^-1 b`` for a small square ``a`` by Gaussian elimination with partial pivoting,
+    unrolled into elementwise operations (XLA fuses them; a LAPACK call per corner and
+    iteration cost more than the arithmetic). ``b``: a vector or a matrix of columns."""
+    n = a.shape[0]
+    vector = b.ndim == 1
+    m = jnp.concatenate([a, b[:, None] if vector else b], axis=1)
+    rows = jnp.arange(n)
+    for k in range(n):
+        pivot = jnp.argmax(jnp.where(rows >= k, jnp.abs(m[:, k]), -1.0))
+        swap = (rows == k)[:, None] * m[pivot] + (rows == pivot)[:, None] * m[k]
+        m = jnp.where(((rows == k) | (rows == pivot))[:, None], swap, m)
+        factors = jnp.where(rows > k, m[:, k] / m[k, k], 0.0)
+        m = m - factors[:, None] * m[k]
+    x = []
+    for k in reversed(range(n)):
+        acc = m[k, n:]
+        for j, xj in zip(range(k + 1, n), reversed(x), strict=True):
+            acc = acc - m[k, j] * xj
+        x.append(acc / m[k, k])
+    out = jnp.stack(x[::-1])
+    return out[:, 0] if vector else out
+
+
 def _newton(w, geometry, travel, rack, pivots, iterations: int):
     def step(_, w):
         res = link_residual(w, geometry, travel, rack, pivots)
         jac = jax.jacfwd(link_residual)(w, geometry, travel, rack, pivots)
-        return w - jnp.linalg.solve(jac, res)
+        return w - solve_small(jac, res)
 
     return jax.lax.fori_loop(0, iterations, step, w, unroll=True)
 
@@ -126,7 +150,7 @@ def _solve_pose_jvp(primals, tangents):
     jac = jax.jacfwd(link_residual)(w, geometry, travel, rack, pivots)
     _, d_res = jax.jvp(lambda g, t, r, p: link_residual(w, g, t, r, p), (geometry, travel, rack, pivots),
                        (d_geometry, d_travel, d_rack, d_pivots))
-    return w, -jnp.linalg.solve(jac, d_res)
+    return w, -solve_small(jac, d_res)
 
 
 # ---- the kinematic map (the guess) ------------------------------------------------------
