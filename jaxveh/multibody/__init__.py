@@ -13,6 +13,7 @@ from ._bodies import (
     RigidBody as RigidBody,
 )
 from ._dynamics import (
+    body_forces as body_forces,
     body_quadratic_forces as body_quadratic_forces,
     body_torque as body_torque,
     energy as energy,

@@ -54,7 +54,7 @@ def _gyroscopic_cross(body, options, p, v):
     return jnp.concatenate([jnp.zeros((3,), v.dtype), cross[3:]])
 
 
-def _body_forces(system: System, params: SystemParams, i: int, pose, v):
+def body_forces(system: System, params: SystemParams, i: int, pose, v):
     """Internal (velocity, elastic) and gravity forces of body ``i`` in its axes."""
     body, options = params.bodies[i], system.options
     r, a, p = pose
@@ -86,7 +86,7 @@ def internal_forces(system: System, params: SystemParams, q, v) -> tuple[Float[A
 def internal_forces_at(system: System, params: SystemParams, poses, vs) -> tuple[Float[Array, " nv"], Float[Array, " nv"]]:
     """:func:`internal_forces` from body poses ``[(r, A, p)]`` and body velocities (one per
     body), for models that compute the poses their own way (e.g. minimal coordinates)."""
-    parts = [_body_forces(system, params, i, poses[i], vs[i]) for i in range(system.n_bodies)]
+    parts = [body_forces(system, params, i, poses[i], vs[i]) for i in range(system.n_bodies)]
     return jnp.concatenate([p[0] for p in parts]), jnp.concatenate([p[1] for p in parts])
 
 

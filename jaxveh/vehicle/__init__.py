@@ -1,6 +1,7 @@
 """The chapter-6 vehicle, built with :mod:`jaxveh.multibody`: the assembled 14-DOF car with
 its flexible chassis (``load_car``), its static set-up, kinematic rigs and rates, and its
-parts.
+parts; and the same car's equations in minimal coordinates (``fast_model``,
+``fast_dynamics``: corner kinematics solved exactly, four corners vectorised).
 
 ``quarter_car`` builds the front-left (or rear-left) double-wishbone corner from the
 Appendix B hard points on a fixed chassis; ``quarter_car_kinematics`` sweeps it (camber,
@@ -55,6 +56,26 @@ from ._corner import (
     quarter_car_wheel_centre as quarter_car_wheel_centre,
     quarter_car_with_hard_points as quarter_car_with_hard_points,
     wheel_angles as wheel_angles,
+)
+from ._corner_kinematics import (
+    CornerGeometry as CornerGeometry,
+    CornerMotion as CornerMotion,
+    KinematicMap as KinematicMap,
+    build_map as build_map,
+    corner_geometry as corner_geometry,
+    corner_motion as corner_motion,
+    corner_poses as corner_poses,
+    map_guess as map_guess,
+    pose_residual as pose_residual,
+)
+from ._fast import (
+    FastDynamics as FastDynamics,
+    FastModel as FastModel,
+    FastState as FastState,
+    fast_dynamics as fast_dynamics,
+    fast_model as fast_model,
+    fast_state_from_library as fast_state_from_library,
+    travel_from_library as travel_from_library,
 )
 from ._powertrain import (
     POWERTRAIN_STATES as POWERTRAIN_STATES,

@@ -97,31 +97,38 @@ def link_residual(w, geometry: CornerGeometry, travel, rack, pivots):
     """The five link equations of one corner, ``(|d|^2 - l^2) / (2 l)`` (m). ``pivots``:
     the inner pivots (5, 3) with the chassis deformation, before the rack."""
     r, a = relative_pose(w, travel, geometry.centre)
-    inner = pivots + rack * geometry.rack[:, None] * jnp.asarray([0.0, 1.0, 0.0])
-    d = inner - (r + geometry.outer @ a.T)
+    inner = pivots + (rack * geometry.rack)[:, None] * jnp.asarray([[0.0, 1.0, 0.0]])
+    d = inner - (r[None, :] + geometry.outer @ a.T)
     return (jnp.sum(d * d, axis=1) - geometry.lengths**2) / (2.0 * geometry.lengths)
 
 
 def solve_small(a, b):
     """``a^-1 b`` for a small square ``a`` by Gaussian elimination with partial pivoting,
     unrolled into elementwise operations (XLA fuses them; a LAPACK call per corner and
-    iteration cost more than the arithmetic). ``b``: a vector or a matrix of columns."""
+    iteration cost more than the arithmetic). ``b``: a vector or a matrix of columns. The
+    row operations come from ``a`` alone, so the result is linear in ``b`` (and can be
+    transposed when ``b`` is a tangent)."""
     n = a.shape[0]
     vector = b.ndim == 1
-    m = jnp.concatenate([a, b[:, None] if vector else b], axis=1)
+    b = b[:, None] if vector else b
     rows = jnp.arange(n)
+
+    def swap(m, k, pivot):
+        row_k, row_p = m[k][None, :], m[pivot][None, :]
+        return jnp.where((rows == k)[:, None], row_p, jnp.where((rows == pivot)[:, None], row_k, m))
+
     for k in range(n):
-        pivot = jnp.argmax(jnp.where(rows >= k, jnp.abs(m[:, k]), -1.0))
-        swap = (rows == k)[:, None] * m[pivot] + (rows == pivot)[:, None] * m[k]
-        m = jnp.where(((rows == k) | (rows == pivot))[:, None], swap, m)
-        factors = jnp.where(rows > k, m[:, k] / m[k, k], 0.0)
-        m = m - factors[:, None] * m[k]
+        pivot = jnp.argmax(jnp.where(rows >= k, jnp.abs(a[:, k]), -1.0))
+        a, b = swap(a, k, pivot), swap(b, k, pivot)
+        factors = jnp.where(rows > k, a[:, k] / a[k, k], 0.0)[:, None]
+        a = a - factors * a[k][None, :]
+        b = b - factors * b[k][None, :]
     x = []
     for k in reversed(range(n)):
-        acc = m[k, n:]
+        acc = b[k]
         for j, xj in zip(range(k + 1, n), reversed(x), strict=True):
-            acc = acc - m[k, j] * xj
-        x.append(acc / m[k, k])
+            acc = acc - a[k, j] * xj
+        x.append(acc / a[k, k])
     out = jnp.stack(x[::-1])
     return out[:, 0] if vector else out
 
@@ -236,6 +243,49 @@ def corner_poses(geometry: CornerGeometry, kmap: KinematicMap, travel, rack, mod
     racks = jnp.broadcast_to(rack, (4,))
     guess = map_guess(kmap, travel, racks)
     return jax.vmap(solve_pose)(guess, geometry, travel, racks, pivots)
+
+
+class CornerMotion(eqx.Module):
+    """Motion of the four uprights relative to the chassis frame (leading axis: corners).
+    ``w`` poses (see the module docs); ``w_dot`` their rates; ``w_acc0`` their
+    accelerations when the travel and modal accelerations are zero (the rack's included);
+    ``sens`` (4, 5, 2 + n) the sensitivities ``dw/d[travel, rack, modes]``."""
+
+    w: Float[Array, "4 5"]
+    w_dot: Float[Array, "4 5"]
+    w_acc0: Float[Array, "4 5"]
+    sens: Float[Array, "4 5 m"]
+
+
+def corner_motion(geometry: CornerGeometry, kmap: KinematicMap, travel, rack, modes, travel_rate, rack_rate,
+                  modal_rate, rack_acc) -> CornerMotion:
+    """Poses, rates and velocity-product accelerations of the four uprights at travels
+    (4,) and rates, rack travel, rate and acceleration (scalars, m), modal coordinates and
+    rates. Rates by the implicit function theorem on the link equations, the
+    velocity-product terms by their second directional derivative along the motion."""
+    w = corner_poses(geometry, kmap, travel, rack, modes)
+    pivots = geometry.inner + jnp.einsum("kpim,m->kpi", geometry.inner_shapes, modes)
+    pivot_rates = jnp.einsum("kpim,m->kpi", geometry.inner_shapes, modal_rate)
+
+    def one(g, w, t, piv, t_rate, piv_rate):
+        def res(w, t, s, piv):
+            return link_residual(w, g, t, s, piv)
+
+        jac_w, jac_t, jac_s, jac_piv = jax.jacfwd(res, argnums=(0, 1, 2, 3))(w, t, rack, piv)
+        jac_p = jnp.einsum("lpi,pim->lm", jac_piv, g.inner_shapes)
+        sens = -solve_small(jac_w, jnp.concatenate([jac_t[:, None], jac_s[:, None], jac_p], axis=1))
+        w_dot = sens @ jnp.concatenate([jnp.stack([t_rate, rack_rate]), modal_rate])
+
+        def along(e):
+            return res(w + e * w_dot, t + e * t_rate, rack + e * rack_rate, piv + e * piv_rate)
+
+        zero = jnp.zeros_like(t)
+        curvature = jax.jvp(lambda e: jax.jvp(along, (e,), (jnp.ones_like(e),))[1], (zero,), (jnp.ones_like(zero),))[1]
+        w_acc0 = sens[:, 1] * rack_acc - solve_small(jac_w, curvature)
+        return sens, w_dot, w_acc0
+
+    sens, w_dot, w_acc0 = jax.vmap(one)(geometry, w, travel, pivots, travel_rate, pivot_rates)
+    return CornerMotion(w=w, w_dot=w_dot, w_acc0=w_acc0, sens=sens)
 
 
 def pose_residual(geometry: CornerGeometry, travel, rack, modes, w) -> Float[Array, ""]:

@@ -6,44 +6,41 @@ velocities ``u = [chassis body velocities (u, omega in chassis axes, modal rates
 travel rates (4), spin rates (4)]``: the chassis as the library's free flexible body, each
 upright by its suspension travel (the wheel centre's height in the chassis frame from its
 design position, m, positive in bump), each wheel by its spin angle about the upright's y
-axis. Corner kinematics (:mod:`._corner_kinematics`) give every upright's pose from the
-travel, the rack and the chassis deformation; every body's velocity is linear in ``u``,
-``v = J(q) u + j(q) rack_rate``, by forward-mode autodiff of that kinematics.
+axis. The corner kinematics (:mod:`._corner_kinematics`) give every upright's pose, its
+rates and its velocity-product accelerations from the travel, the rack and the chassis
+deformation, exactly, for the four corners at once.
 
-The equations are Kane's: ``J^T (M (J u_dot + a0) - Q) = 0`` with the library's body mass
-matrices ``M``, internal, elastic and gravity forces and the car's force elements
-(:func:`jaxveh.vehicle.car_elements`, same code as the library car), ``a0`` the body
-accelerations at ``u_dot = 0`` (one JVP along the motion). No constraint projection, no
-drift: the links are closed exactly at every evaluation.
+The equations are Kane's: ``sum_b J_b^T (M_b (J_b u_dot + a0_b) - Q_b) = 0`` over the
+chassis (the library's modal body: mass matrix, quadratic velocity, elastic and gravity
+forces), the uprights and the wheels (rotors of spin inertia about the upright's y axis;
+their mass is the upright's), with ``J_b`` the partial velocities, ``a0_b`` the body
+accelerations at ``u_dot = 0`` and ``Q_b`` gravity and the car's force elements
+(:func:`jaxveh.vehicle.car_elements`, the same code as the library car, fed with the same
+:class:`jaxveh.multibody.Kinematics`). No constraint projection and no drift: the links
+close exactly at every evaluation.
 """
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array, Float
 
-from ..multibody import (
-    SystemParams,
-    element_forces,
-    generalised_forces,
-    input_state,
-    internal_forces_at,
-    kinematics,
-    mass_matrix_at,
-    rotation_matrix,
-)
+from ..multibody import Kinematics, SystemParams, body_forces, element_forces, input_state, rotation_matrix
 from ..multibody._inputs import as_inputs
-from ..multibody._rotations import angular_velocity_matrix, elementary
+from ..multibody._rotations import angular_velocity_matrix, elementary, skew
 from ._car import CORNERS, Car, system_params, wheel_centres
 from ._corner_kinematics import (
     CornerGeometry,
+    CornerMotion,
     KinematicMap,
     build_map,
     corner_geometry,
-    corner_poses,
+    corner_motion,
     pose_residual,
-    relative_pose,
 )
+
+_EY = ((0.0, 1.0, 0.0),)  # the spin axis, as a row
 
 
 class FastModel(eqx.Module):
@@ -78,107 +75,269 @@ def split(car: Car, x):
     return x[:n], x[n : n + 4], x[n + 4 :]
 
 
-def _rel_motion(model: FastModel, travel, rack, modes):
-    """Upright origins (4, 3) and rotations (4, 3, 3) relative to the chassis frame."""
-    w = corner_poses(model.geometry, model.kmap, travel, rack, modes)
-    return jax.vmap(relative_pose)(w, travel, model.geometry.centre)
+# ---- static layout ---------------------------------------------------------------------------
 
 
-def _vee(m):
-    return jnp.stack([m[..., 2, 1], m[..., 0, 2], m[..., 1, 0]], axis=-1)
+def _layout(car: Car):
+    """Static index sets: chassis points, upright points with their corner, wheel points
+    with their corner, and the body index of each corner's upright and wheel."""
+    sys = car.system
+    chassis = sys.body_names.index("chassis")
+    uprights = [sys.body_names.index(f"{c}.upright") for c in CORNERS]
+    wheels = [sys.body_names.index(f"{c}.wheel") for c in CORNERS]
+    on_chassis = [k for k, b in enumerate(sys.point_body) if b == chassis]
+    on_upright = [(k, uprights.index(b)) for k, b in enumerate(sys.point_body) if b in uprights]
+    on_wheel = [(k, wheels.index(b)) for k, b in enumerate(sys.point_body) if b in wheels]
+    if len(on_chassis) + len(on_upright) + len(on_wheel) != len(sys.point_names):
+        raise ValueError("the fast car expects every point on the chassis, an upright or a wheel")
+    order = on_chassis + [k for k, _ in on_upright] + [k for k, _ in on_wheel]
+    return {
+        "chassis_points": np.asarray(on_chassis, int),
+        "upright_points": np.asarray([k for k, _ in on_upright], int),
+        "upright_corner": np.asarray([c for _, c in on_upright], int),
+        "wheel_points": np.asarray([k for k, _ in on_wheel], int),
+        "wheel_corner": np.asarray([c for _, c in on_wheel], int),
+        "unstack": np.argsort(np.asarray(order, int)),
+        "uprights": uprights,
+        "wheels": wheels,
+    }
 
 
-def motion(car: Car, model: FastModel, q, u, rack, rack_rate):
-    """Library body poses ``[(r, A, p)]`` and body velocities ``[v]`` (body axes, library
-    order) of every body at ``(q, u)`` and rack travel / rate (m, m/s)."""
+# ---- motion ----------------------------------------------------------------------------------
+
+
+class CarMotion(eqx.Module):
+    """Poses and velocities of the chassis, uprights and wheels at one state (see
+    :func:`car_motion`)."""
+
+    r_c: Float[Array, "3"]
+    a_c: Float[Array, "3 3"]
+    r_rel: Float[Array, "4 3"]
+    a_rel: Float[Array, "4 3 3"]
+    spin_rot: Float[Array, "4 3 3"]
+    e_rel: Float[Array, "4 3 3"]
+    corners: CornerMotion
+    velocity: object
+
+
+def _rel_pose(corners: CornerMotion, travel, centre):
+    r = centre + jnp.concatenate([corners.w[:, :2], travel[:, None]], axis=1)
+    a = jax.vmap(lambda x: rotation_matrix("zxy", x))(corners.w[:, 2:])
+    e = jax.vmap(lambda x: angular_velocity_matrix("zxy", x))(corners.w[:, 2:])
+    return r, a, e
+
+
+def _velocities(m, corners: CornerMotion, vc, travel_rate, spin_rate, rack_rate):
+    """Body velocities (body axes; affine in the velocities): chassis ``vc``, uprights
+    ``(v, omega)``, wheels' angular velocity in upright axes."""
+    n_modes = vc.shape[0] - 6
+    xi = jnp.concatenate([travel_rate[:, None], jnp.broadcast_to(rack_rate, (4, 1)),
+                          jnp.broadcast_to(vc[6:], (4, n_modes))], axis=1)
+    w_dot = jnp.einsum("kwm,km->kw", corners.sens, xi)
+    r_dot = jnp.concatenate([w_dot[:, :2], travel_rate[:, None]], axis=1)
+    omega_rel = jnp.einsum("kij,kj->ki", m.e_rel, w_dot[:, 2:])
+    u_c, w_c = vc[:3], vc[3:6]
+    a_relt = jnp.swapaxes(m.a_rel, 1, 2)
+    v_up = jnp.einsum("kij,kj->ki", a_relt, u_c[None, :] + jnp.cross(w_c[None, :], m.r_rel) + r_dot)
+    w_up = jnp.einsum("kij,j->ki", a_relt, w_c) + omega_rel
+    w_wheel = w_up + spin_rate[:, None] * jnp.asarray(_EY)
+    return vc, v_up, w_up, w_wheel
+
+
+def car_motion(car: Car, model: FastModel, q, u, rack, rack_rate, rack_acc) -> CarMotion:
+    """Corner motion and every body's pose and velocity at ``(q, u)``, rack travel, rate and
+    acceleration (m, m/s, m/s^2)."""
     qc, travel, spin = split(car, q)
     vc, travel_rate, spin_rate = split(car, u)
-    r_c, a_c, modes = qc[:3], rotation_matrix("zyx", qc[3:6]), qc[6:]
+    corners = corner_motion(model.geometry, model.kmap, travel, rack, qc[6:], travel_rate, rack_rate, vc[6:],
+                            rack_acc)
+    r_rel, a_rel, e_rel = _rel_pose(corners, travel, model.geometry.centre)
+    m = CarMotion(r_c=qc[:3], a_c=rotation_matrix("zyx", qc[3:6]), r_rel=r_rel, a_rel=a_rel,
+                  spin_rot=jax.vmap(lambda a: elementary(1, a))(spin), e_rel=e_rel, corners=corners, velocity=None)
+    return eqx.tree_at(lambda x: x.velocity, m, _velocities(m, corners, vc, travel_rate, spin_rate, rack_rate),
+                       is_leaf=lambda x: x is None)
+
+
+def _bias(m: CarMotion, vc, travel_rate):
+    """Body accelerations at ``u_dot = 0`` (body axes): uprights ``(v_dot, omega_dot)``; the
+    chassis's are zero and the wheels' angular one is the upright's."""
+    c = m.corners
+    r_dot = jnp.concatenate([c.w_dot[:, :2], travel_rate[:, None]], axis=1)
+    r_acc = jnp.concatenate([c.w_acc0[:, :2], jnp.zeros((4, 1))], axis=1)
+    omega_rel = jnp.einsum("kij,kj->ki", m.e_rel, c.w_dot[:, 2:])
+    e_dot = jax.vmap(lambda a, da: jax.jvp(lambda x: angular_velocity_matrix("zxy", x), (a,), (da,))[1])(
+        c.w[:, 2:], c.w_dot[:, 2:])
+    omega_rel_acc = jnp.einsum("kij,kj->ki", m.e_rel, c.w_acc0[:, 2:]) + jnp.einsum("kij,kj->ki", e_dot, c.w_dot[:, 2:])
     u_c, w_c = vc[:3], vc[3:6]
-    (r_rel, a_rel), (dr_rel, da_rel) = jax.jvp(
-        lambda t, r, p: _rel_motion(model, t, r, p), (travel, rack, modes), (travel_rate, rack_rate, vc[6:]))
-    a_relt = jnp.swapaxes(a_rel, 1, 2)
-    r_up = r_c + r_rel @ a_c.T
-    a_up = jnp.einsum("ij,kjl->kil", a_c, a_rel)
-    v_up = jnp.einsum("kij,kj->ki", a_relt, u_c + jnp.cross(w_c, r_rel) + dr_rel)
-    w_up = jnp.einsum("kij,j->ki", a_relt, w_c) + _vee(jnp.einsum("kij,kjl->kil", a_relt, da_rel))
-    spin_rot = jax.vmap(lambda a: elementary(1, a))(spin)  # upright -> wheel: R_y(spin)
-    spin_rot_t = jnp.swapaxes(spin_rot, 1, 2)
-    a_wh = jnp.einsum("kij,kjl->kil", a_up, spin_rot)
-    v_wh = jnp.einsum("kij,kj->ki", spin_rot_t, v_up)
-    w_wh = jnp.einsum("kij,kj->ki", spin_rot_t, w_up) + spin_rate[:, None] * jnp.asarray([0.0, 1.0, 0.0])
-    poses, vs = {"chassis": (r_c, a_c, modes)}, {"chassis": vc}
-    empty = jnp.zeros((0,))
-    for k, corner in enumerate(CORNERS):
-        poses[f"{corner}.upright"] = (r_up[k], a_up[k], empty)
-        poses[f"{corner}.wheel"] = (r_up[k], a_wh[k], empty)
-        vs[f"{corner}.upright"] = jnp.concatenate([v_up[k], w_up[k]])
-        vs[f"{corner}.wheel"] = jnp.concatenate([v_wh[k], w_wh[k]])
-    names = car.system.body_names
-    return [poses[n] for n in names], [vs[n] for n in names]
+    a_relt = jnp.swapaxes(m.a_rel, 1, 2)
+    x = u_c[None, :] + jnp.cross(w_c[None, :], m.r_rel) + r_dot
+    v_acc = jnp.einsum("kij,kj->ki", a_relt, jnp.cross(w_c[None, :], r_dot) + r_acc) - jnp.cross(
+        omega_rel, jnp.einsum("kij,kj->ki", a_relt, x))
+    w_acc = -jnp.cross(omega_rel, jnp.einsum("kij,j->ki", a_relt, w_c)) + omega_rel_acc
+    return v_acc, w_acc
+
+
+# ---- kinematics for the force elements --------------------------------------------------------
+
+
+def _point_tables(car: Car, params: SystemParams, lay):
+    pts = params.points
+    ch = lay["chassis_points"]
+    local = jnp.stack([pts[k].position for k in ch])
+    n = car.n_modes
+    shapes = jnp.stack([pts[k].shapes for k in ch]) if n else jnp.zeros((len(ch), 3, 0))
+    rshapes = jnp.stack([pts[k].rotation_shapes for k in ch]) if n else jnp.zeros((len(ch), 3, 0))
+    coupling = params.bodies[car.system.body_names.index("chassis")].coupling if n else jnp.zeros(())
+    inputs = jnp.stack([pts[k].input_direction * float(car.system.point_input[k] >= 0) for k in ch])
+    up = jnp.stack([pts[k].position for k in lay["upright_points"]])
+    wh = jnp.stack([pts[k].position for k in lay["wheel_points"]])
+    return local, coupling * shapes, coupling * rshapes, inputs, up, wh
+
+
+def _point_kinematics(car, model, lay, m: CarMotion, q, rack):
+    """Positions and material orientations of every point (library order)."""
+    qc = split(car, q)[0]
+    local, shapes, rshapes, inputs, up, wh = _point_tables(car, model.params, lay)
+    modes = qc[6:]
+    x_ch = local + shapes @ modes + rack * inputs
+    a_up = jnp.einsum("ij,kjl->kil", m.a_c, m.a_rel)
+    r_up = m.r_c[None, :] + m.r_rel @ m.a_c.T
+    a_wh = jnp.einsum("kij,kjl->kil", a_up, m.spin_rot)
+    uc, wc = lay["upright_corner"], lay["wheel_corner"]
+    x = jnp.concatenate([
+        m.r_c[None, :] + x_ch @ m.a_c.T,
+        r_up[uc] + jnp.einsum("kij,kj->ki", a_up[uc], up),
+        r_up[wc] + jnp.einsum("kij,kj->ki", a_wh[wc], wh),
+    ])[lay["unstack"]]
+    theta = rshapes @ modes
+    rot_ch = m.a_c[None] + jnp.einsum("ij,kjl->kil", m.a_c, jax.vmap(skew)(theta))
+    rots = jnp.concatenate([rot_ch, a_up[uc], a_wh[wc]])[lay["unstack"]]
+    return x, rots, r_up, a_up, a_wh
+
+
+def _point_rates(car, model, lay, m: CarMotion, velocity, a_up, q):
+    """Velocities and angular velocities (global axes) of every point, linear in the body
+    velocities ``velocity`` (plus the rack rate through ``velocity``)."""
+    local, shapes, rshapes, inputs, up, wh = _point_tables(car, model.params, lay)
+    qc = split(car, q)[0]
+    vc, v_up, w_up, w_wheel = velocity
+    x_ch = local + shapes @ qc[6:]
+    uc, wc = lay["upright_corner"], lay["wheel_corner"]
+    xd_ch = (vc[None, :3] + jnp.cross(vc[None, 3:6], x_ch) + shapes @ vc[6:]) @ m.a_c.T
+    xd_up = jnp.einsum("kij,kj->ki", a_up[uc], v_up[uc] + jnp.cross(w_up[uc], up))
+    # wheel points (the hubs) sit on the spin axis: their velocity is the upright's there
+    xd_wh = jnp.einsum("kij,kj->ki", a_up[wc], v_up[wc] + jnp.cross(w_wheel[wc], jnp.einsum(
+        "kij,kj->ki", m.spin_rot[wc], wh)))
+    om_ch = (vc[None, 3:6] + rshapes @ vc[6:]) @ m.a_c.T
+    om_up = jnp.einsum("kij,kj->ki", a_up[uc], w_up[uc])
+    om_wh = jnp.einsum("kij,kj->ki", a_up[wc], w_wheel[wc])
+    xd = jnp.concatenate([xd_ch, xd_up, xd_wh])[lay["unstack"]]
+    om = jnp.concatenate([om_ch, om_up, om_wh])[lay["unstack"]]
+    return xd, om
+
+
+# ---- equations -------------------------------------------------------------------------------
+
+
+class FastDynamics(eqx.Module):
+    """The fast car's equations at one state: ``q_dot``, ``u_dot``, ``aux_dot``, the rack
+    travel and rate, the force elements' :class:`Kinematics` and ``link_residual`` (m, what
+    the corner solve left)."""
+
+    q_dot: Float[Array, " n"]
+    u_dot: Float[Array, " n"]
+    aux_dot: Float[Array, " na"]
+    rack: Float[Array, ""]
+    rack_rate: Float[Array, ""]
+    kinematics: Kinematics
+    link_residual: Float[Array, ""]
 
 
 def coordinate_rates(car: Car, q, u):
     """``q_dot`` from ``(q, u)``: chassis position rate in global axes, angle rates from the
     body angular velocity (``"zyx"``), modal, travel and spin rates."""
-    qc, _, _ = split(car, q)
-    vc = u[: 6 + car.n_modes]
-    angles = qc[3:6]
-    r_dot = rotation_matrix("zyx", angles) @ vc[:3]
-    angle_rates = jnp.linalg.solve(angular_velocity_matrix("zyx", angles), vc[3:6])
+    angles = q[3:6]
+    r_dot = rotation_matrix("zyx", angles) @ u[:3]
+    angle_rates = jnp.linalg.solve(angular_velocity_matrix("zyx", angles), u[3:6])
     return jnp.concatenate([r_dot, angle_rates, u[6:]])
 
 
-def _body_velocity_vector(car, model, q, u, rack, rack_rate):
-    return jnp.concatenate(motion(car, model, q, u, rack, rack_rate)[1])
-
-
-class FastDynamics(eqx.Module):
-    """The fast car's equations at one state: ``q_dot``, ``u_dot``, ``aux_dot``, the body
-    velocities ``v`` and accelerations ``v_dot`` (library layout), the rack travel and rate,
-    the force elements' :class:`Kinematics`, and ``link_residual`` (m, what the corner
-    solve left)."""
-
-    q_dot: Float[Array, " n"]
-    u_dot: Float[Array, " n"]
-    aux_dot: Float[Array, " na"]
-    v: Float[Array, " nv"]
-    v_dot: Float[Array, " nv"]
-    rack: Float[Array, ""]
-    rack_rate: Float[Array, ""]
-    kinematics: object
-    link_residual: Float[Array, ""]
+def _rack(system, law, t, q, aux, q_dot=None, aux_dot=None):
+    value, rate = input_state(system, law, t, q, aux)
+    if q_dot is None:
+        return value, rate
+    return jax.jvp(lambda tt, qq, aa: law.rate(tt, qq, aa), (t, q, aux), (jnp.ones_like(t), q_dot, aux_dot))[1]
 
 
 def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) -> FastDynamics:
     """Kane's equations of the fast car at ``(t, q, u, aux)`` (see the module docs).
     ``inputs``: the rack law (a function of time or a :class:`jaxveh.multibody.AbstractInputs`;
     closed-loop laws read the fast car's ``q``)."""
-    system, params = car.system, model.params
+    system, params, lay = car.system, model.params, _layout(car)
     t = jnp.asarray(t, q.dtype)
     law = as_inputs(inputs)
-    rack_v, rack_dot_v = input_state(system, law, t, q, aux)
+    rack_v, rack_dot_v = _rack(system, law, t, q, aux)
     rack, rack_rate = rack_v[0], rack_dot_v[0]
-    poses, vs = motion(car, model, q, u, rack, rack_rate)
-    v = jnp.concatenate(vs)
     q_dot = coordinate_rates(car, q, u)
-    kin = kinematics(system, params, q, vs, poses, rack_v, rack_dot_v, t)
+    vc, travel_rate, _ = split(car, u)
+    # the rack acceleration needs aux_dot, which needs the kinematics: a first pass at zero
+    m = car_motion(car, model, q, u, rack, rack_rate, jnp.zeros_like(rack))
+    x, rots, r_up, a_up, a_wh = _point_kinematics(car, model, lay, m, q, rack)
+    xd, om = _point_rates(car, model, lay, m, m.velocity, a_up, q)
+    origins, rotations = _body_frames(car, lay, m, r_up, a_up, a_wh)
+    kin = Kinematics(t=t, q=q, v=u, u=rack_v, u_dot=rack_dot_v, origins=origins, rotations=rotations, x=x, xd=xd,
+                     point_rotations=rots, point_omega=om,
+                     modal=tuple(q[6:6 + car.n_modes] if i == 0 else jnp.zeros((0,)) for i in range(len(system.body_names))))
     forces, torques, aux_dot = element_forces(system, params, elements, kin, aux)
-    q_applied = generalised_forces(system, params, q, poses, forces, torques)
-    q_int, q_grav = internal_forces_at(system, params, poses, vs)
-    rack_acc = jax.jvp(lambda tt, qq, aa: law.rate(tt, qq, aa), (t, q, aux), (jnp.ones_like(t), q_dot, aux_dot))[1][0]
-    jac = jax.jacfwd(lambda uu: _body_velocity_vector(car, model, q, uu, rack, jnp.zeros_like(rack)))(u)
-    a0 = jax.jvp(lambda qq, r, rd: _body_velocity_vector(car, model, qq, u, r, rd), (q, rack, rack_rate),
-                 (q_dot, rack_rate, rack_acc))[1]
-    m_full = mass_matrix_at(system, params, poses)
-    m_red = jac.T @ m_full @ jac
-    rhs = jac.T @ (q_int + q_grav + q_applied - m_full @ a0)
+    rack_acc = _rack(system, law, t, q, aux, q_dot, aux_dot)[0] if system.n_inputs else jnp.zeros_like(rack)
+    m = car_motion(car, model, q, u, rack, rack_rate, rack_acc)
+
+    def body_velocities(uu):
+        vcc, trr, srr = split(car, uu)
+        return _velocities(m, m.corners, vcc, trr, srr, jnp.zeros_like(rack))
+
+    def point_rates(uu):
+        return _point_rates(car, model, lay, m, body_velocities(uu), a_up, q)
+
+    q_applied = jax.linear_transpose(point_rates, u)((forces, torques))[0]
+    _, jac_v, jac_w, jac_wh = jax.jacfwd(body_velocities)(u)
+    v_acc, w_acc = _bias(m, vc, travel_rate)
+    chassis = params.bodies[0]
+    m_c = chassis.mass_matrix(q[6:6 + car.n_modes], system.options)
+    a_c = m.a_c
+    quad_el, grav = body_forces(system, params, 0, (m.r_c, a_c, q[6:6 + car.n_modes]), vc)
+    n_c = 6 + car.n_modes
+    m_red = jnp.zeros((u.shape[0], u.shape[0])).at[:n_c, :n_c].add(m_c)
+    rhs = jnp.zeros_like(u).at[:n_c].add(quad_el + grav) + q_applied
+    _, v_up, w_up, w_wheel = m.velocity
+    mass = jnp.stack([params.bodies[i].mass for i in lay["uprights"]])
+    inertia = jnp.stack([params.bodies[i].inertia for i in lay["uprights"]])
+    spin = jnp.stack([params.bodies[i].inertia[1, 1] for i in lay["wheels"]])
+    g_up = jnp.einsum("kji,j->ki", jnp.einsum("ij,kjl->kil", a_c, m.a_rel), params.gravity)
+    # uprights: m (v_dot + w x v) = F, J w_dot + w x J w = T (c.g. at the wheel centre)
+    f_up = mass[:, None] * (g_up - v_acc - jnp.cross(w_up, v_up))
+    t_up = -jnp.einsum("kij,kj->ki", inertia, w_acc) - jnp.cross(w_up, jnp.einsum("kij,kj->ki", inertia, w_up))
+    # wheels: rotors about the upright's y axis (angular velocity w_wheel in upright axes)
+    h_wh = spin[:, None] * w_wheel * jnp.asarray(_EY)
+    t_wh = -spin[:, None] * w_acc * jnp.asarray(_EY) - jnp.cross(w_wheel, h_wh)
+    m_red = m_red + jnp.einsum("kia,k,kib->ab", jac_v, mass, jac_v) + jnp.einsum(
+        "kia,kij,kjb->ab", jac_w, inertia, jac_w) + jnp.einsum("ka,k,kb->ab", jac_wh[:, 1], spin, jac_wh[:, 1])
+    rhs = rhs + jnp.einsum("kia,ki->a", jac_v, f_up) + jnp.einsum("kia,ki->a", jac_w, t_up) + jnp.einsum(
+        "kia,ki->a", jac_wh, t_wh)
     u_dot = jnp.linalg.solve(m_red, rhs)
-    _, travel, _ = split(car, q)
-    w = corner_poses(model.geometry, model.kmap, travel, rack, q[6:6 + car.n_modes])
-    residual = pose_residual(model.geometry, travel, rack, q[6:6 + car.n_modes], w)
-    return FastDynamics(q_dot=q_dot, u_dot=u_dot, aux_dot=aux_dot, v=v, v_dot=jac @ u_dot + a0, rack=rack,
-                        rack_rate=rack_rate, kinematics=kin, link_residual=residual)
+    residual = pose_residual(model.geometry, split(car, q)[1], rack, q[6:6 + car.n_modes], m.corners.w)
+    return FastDynamics(q_dot=q_dot, u_dot=u_dot, aux_dot=aux_dot, rack=rack, rack_rate=rack_rate, kinematics=kin,
+                        link_residual=residual)
+
+
+def _body_frames(car, lay, m: CarMotion, r_up, a_up, a_wh):
+    names = car.system.body_names
+    origins, rotations = [None] * len(names), [None] * len(names)
+    origins[names.index("chassis")], rotations[names.index("chassis")] = m.r_c, m.a_c
+    for k in range(4):
+        origins[lay["uprights"][k]], rotations[lay["uprights"][k]] = r_up[k], a_up[k]
+        origins[lay["wheels"][k]], rotations[lay["wheels"][k]] = r_up[k], a_wh[k]
+    return jnp.stack(origins), jnp.stack(rotations)
 
 
 # ---- states of the library car ------------------------------------------------------------
@@ -200,7 +359,7 @@ def travel_from_library(car: Car, q_lib) -> Float[Array, "4"]:
     return jnp.stack(out)
 
 
-def state_from_library(car: Car, q_lib, y_lib, aux) -> FastState:
+def fast_state_from_library(car: Car, q_lib, y_lib, aux) -> FastState:
     """The fast car's state at a library-car state (assembled ``q_lib``, joint velocities
     ``y_lib`` that satisfy the velocity constraints)."""
     from ..multibody import velocity_maps
@@ -217,3 +376,4 @@ def state_from_library(car: Car, q_lib, y_lib, aux) -> FastState:
     q = jnp.concatenate([q_lib[chassis], travel, spin])
     u = jnp.concatenate([y_lib[chassis], travel_rate, spin_rate])
     return FastState(q=q, u=u, aux=aux)
+
