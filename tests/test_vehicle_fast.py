@@ -20,7 +20,6 @@ from jaxveh.vehicle import (
     load_car,
     map_guess,
     pose_residual,
-    steering,
     system_params,
     travel_from_library,
 )

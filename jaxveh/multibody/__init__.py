@@ -18,9 +18,7 @@ from ._dynamics import (
     body_torque as body_torque,
     energy as energy,
     internal_forces as internal_forces,
-    internal_forces_at as internal_forces_at,
     mass_matrix as mass_matrix,
-    mass_matrix_at as mass_matrix_at,
     point_force as point_force,
 )
 from ._errors import (

@@ -80,19 +80,10 @@ def _mass_blocks(system, params, poses):
 def internal_forces(system: System, params: SystemParams, q, v) -> tuple[Float[Array, " nv"], Float[Array, " nv"]]:
     """``pQi`` split in two: ``(velocity + elastic + damping forces, gravity forces)`` in
     body-frame velocity coordinates ``v`` (eqs. 5.35, 5.43-5.45)."""
-    return internal_forces_at(system, params, body_poses(system, params, q), _split(system, v, system.v_offsets))
-
-
-def internal_forces_at(system: System, params: SystemParams, poses, vs) -> tuple[Float[Array, " nv"], Float[Array, " nv"]]:
-    """:func:`internal_forces` from body poses ``[(r, A, p)]`` and body velocities (one per
-    body), for models that compute the poses their own way (e.g. minimal coordinates)."""
+    poses = body_poses(system, params, q)
+    vs = _split(system, v, system.v_offsets)
     parts = [body_forces(system, params, i, poses[i], vs[i]) for i in range(system.n_bodies)]
     return jnp.concatenate([p[0] for p in parts]), jnp.concatenate([p[1] for p in parts])
-
-
-def mass_matrix_at(system: System, params: SystemParams, poses) -> Float[Array, "nv nv"]:
-    """:func:`mass_matrix` from body poses ``[(r, A, p)]``."""
-    return jax.scipy.linalg.block_diag(*_mass_blocks(system, params, poses))
 
 
 def point_force(system: System, params: SystemParams, q, point: str, force, frame: str = "global", u=None):

@@ -83,10 +83,6 @@ def corner_geometry(system: System, params: SystemParams, centres) -> CornerGeom
                           outer=jnp.stack(outer), lengths=jnp.stack(lengths), centre=centres)
 
 
-def _one(geometry: CornerGeometry, k: int) -> CornerGeometry:
-    return jax.tree.map(lambda x: x[k], geometry)
-
-
 def relative_pose(w: Float[Array, "5"], travel, centre) -> tuple[Float[Array, "3"], Float[Array, "3 3"]]:
     """Upright origin (m) and rotation in the chassis frame from ``w`` and the travel (m)."""
     r = centre + jnp.stack([w[0], w[1], travel])

@@ -286,8 +286,7 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     xd, om = _point_rates(car, model, lay, m, m.velocity, a_up, q)
     origins, rotations = _body_frames(car, lay, m, r_up, a_up, a_wh)
     kin = Kinematics(t=t, q=q, v=u, u=rack_v, u_dot=rack_dot_v, origins=origins, rotations=rotations, x=x, xd=xd,
-                     point_rotations=rots, point_omega=om,
-                     modal=tuple(q[6:6 + car.n_modes] if i == 0 else jnp.zeros((0,)) for i in range(len(system.body_names))))
+                     point_rotations=rots, point_omega=om, modal=_modal_values(car, q))
     forces, torques, aux_dot = element_forces(system, params, elements, kin, aux)
     rack_acc = _rack(system, law, t, q, aux, q_dot, aux_dot)[0] if system.n_inputs else jnp.zeros_like(rack)
     m = car_motion(car, model, q, u, rack, rack_rate, rack_acc)
@@ -328,6 +327,11 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     residual = pose_residual(model.geometry, split(car, q)[1], rack, q[6:6 + car.n_modes], m.corners.w)
     return FastDynamics(q_dot=q_dot, u_dot=u_dot, aux_dot=aux_dot, rack=rack, rack_rate=rack_rate, kinematics=kin,
                         link_residual=residual)
+
+
+def _modal_values(car, q):
+    """Modal coordinates of every body (library order): the chassis's, none for the rest."""
+    return tuple(q[6:6 + car.n_modes] if name == "chassis" else jnp.zeros((0,)) for name in car.system.body_names)
 
 
 def _body_frames(car, lay, m: CarMotion, r_up, a_up, a_wh):
