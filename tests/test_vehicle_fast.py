@@ -192,3 +192,12 @@ def test_new_parameter_values_never_retrace(car):
                         stiffer.params.vehicle.hard_points_rear.points + 1e-3)
     second = accelerations(moved)
     assert bool(jnp.all(jnp.isfinite(second))) and float(jnp.max(jnp.abs(second - first))) > 0.0
+
+
+def test_state_of_the_wrong_size_is_refused(car):
+    elements = car_elements(car, ConstantSpeed(10.0))
+    model = fast_model(car)
+    with pytest.raises(ValueError, match=r"q must hold 20 values \(chassis 6 \+ 6 modes"):
+        fast_dynamics(car, model, jnp.zeros((19,)), jnp.zeros((20,)), jnp.zeros((10,)), 0.0, _rack_law, elements)
+    with pytest.raises(ValueError, match=r"aux must hold 10 values"):
+        fast_dynamics(car, model, jnp.zeros((20,)), jnp.zeros((20,)), jnp.zeros((8,)), 0.0, _rack_law, elements)

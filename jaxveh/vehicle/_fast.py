@@ -269,10 +269,20 @@ def _rack(system, law, t, q, aux, q_dot=None, aux_dot=None):
     return jax.jvp(lambda tt, qq, aa: law.rate(tt, qq, aa), (t, q, aux), (jnp.ones_like(t), q_dot, aux_dot))[1]
 
 
+def _check_state(car: Car, q, u, aux, elements):
+    n = 14 + car.n_modes
+    n_aux = sum(len(e.aux_names) for e in elements)
+    layout = f"chassis 6 + {car.n_modes} modes, 4 travels, 4 spins"
+    for name, x, size, what in (("q", q, n, layout), ("u", u, n, layout), ("aux", aux, n_aux, "the elements' states")):
+        if jnp.shape(x) != (size,):
+            raise ValueError(f"{name} must hold {size} values ({what}), got shape {jnp.shape(x)}")
+
+
 def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) -> FastDynamics:
     """Kane's equations of the fast car at ``(t, q, u, aux)`` (see the module docs).
     ``inputs``: the rack law (a function of time or a :class:`jaxveh.multibody.AbstractInputs`;
     closed-loop laws read the fast car's ``q``)."""
+    _check_state(car, q, u, aux, elements)
     system, params, lay = car.system, model.params, _layout(car)
     t = jnp.asarray(t, q.dtype)
     law = as_inputs(inputs)
