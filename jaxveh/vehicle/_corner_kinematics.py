@@ -26,9 +26,9 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from ..multibody import System, SystemParams, rotation_matrix
+from ._car import CORNERS
 from ._corner import QUARTER_CAR_LINKS
 
-CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
 #: Inner (chassis) and outer (upright) points of the five links, in Table 6.3's order.
 INNER_POINTS = tuple(link[1] for link in QUARTER_CAR_LINKS)
 OUTER_POINTS = tuple(link[2] for link in QUARTER_CAR_LINKS)

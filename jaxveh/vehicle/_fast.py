@@ -290,7 +290,7 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     rack, rack_rate = rack_v[0], rack_dot_v[0]
     q_dot = coordinate_rates(car, q, u)
     vc, travel_rate, _ = split(car, u)
-    # the rack acceleration needs aux_dot, which needs the kinematics: a first pass at zero
+    # the rack acceleration needs aux_dot, which needs the kinematics: motion at zero first
     m = car_motion(car, model, q, u, rack, rack_rate, jnp.zeros_like(rack))
     x, rots, r_up, a_up, a_wh = _point_kinematics(car, model, lay, m, q, rack)
     xd, om = _point_rates(car, model, lay, m, m.velocity, a_up, q)
@@ -299,7 +299,8 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
                      point_rotations=rots, point_omega=om, modal=_modal_values(car, q))
     forces, torques, aux_dot = element_forces(system, params, elements, kin, aux)
     rack_acc = _rack(system, law, t, q, aux, q_dot, aux_dot)[0] if system.n_inputs else jnp.zeros_like(rack)
-    m = car_motion(car, model, q, u, rack, rack_rate, rack_acc)
+    # the rack acceleration enters the corners' velocity-product terms linearly
+    m = eqx.tree_at(lambda x: x.corners.w_acc0, m, m.corners.w_acc0 + m.corners.sens[:, :, 1] * rack_acc)
 
     def body_velocities(uu):
         vcc, trr, srr = split(car, uu)
