@@ -241,8 +241,10 @@ def test_car_file_errors_name_the_field(tmp_path):
 
 
 def test_form_is_checked():
-    with pytest.raises(ParameterError, match="form"):
-        vehicle.load_car(form="fast")
+    with pytest.raises(ParameterError, match="form = 'quick'.*'fast', 'library'"):
+        vehicle.load_car(form="quick", modes=0)
+    assert vehicle.load_car(modes=0).form == "fast"
+    assert vehicle.load_car(modes=0, form="library").form == "library"
 
 
 # ---- CLI -------------------------------------------------------------------------------------

@@ -19,11 +19,13 @@ from ._aero import (
 )
 from ._car import (
     CORNER_KEYS as CORNER_KEYS,
+    FORMS as FORMS,
     CORNERS as CORNERS,
     MAX_MODES as MAX_MODES,
     Car as Car,
     CarParams as CarParams,
     car_elements as car_elements,
+    check_form as check_form,
     design_coordinates as design_coordinates,
     design_spring_lengths as design_spring_lengths,
     load_car as load_car,

@@ -92,12 +92,15 @@ class CarParams(eqx.Module):
 class Car(eqx.Module):
     """The car: its static multibody ``system`` (topology, names), the library parameters
     ``template`` that are not design data (spin-axis directions, rack direction, gravity),
-    the design ``params`` and the chassis mode count ``n_modes`` (static)."""
+    the design ``params``, the chassis mode count ``n_modes`` and the ``form`` the car's
+    manoeuvres run on by default (both static): ``"fast"`` (the equations in minimal
+    coordinates, :mod:`._fast`) or ``"library"`` (this multibody system)."""
 
     system: System
     template: SystemParams
     params: CarParams
     n_modes: int = eqx.field(static=True)
+    form: str = eqx.field(static=True, default="fast")
 
     @property
     def q_design(self) -> Float[Array, " nq"]:
@@ -350,6 +353,17 @@ def _frame(name: str, where: str):
     return fe.load_frame(name)
 
 
+#: The forms a car's equations come in (see :class:`Car`).
+FORMS = ("fast", "library")
+
+
+def check_form(form) -> str:
+    """``form`` if it names one of :data:`FORMS`, else a :class:`ParameterError`."""
+    if form not in FORMS:
+        raise ParameterError(f"form = {form!r} is not available: allowed {', '.join(map(repr, FORMS))}")
+    return form
+
+
 def _check_modes(modes) -> int:
     if isinstance(modes, bool) or not isinstance(modes, (int, np.integer)) or not 0 <= modes <= MAX_MODES:
         raise ParameterError(f"modes = {modes!r} is out of range: allowed integers 0 (rigid chassis) to {MAX_MODES}")
@@ -367,16 +381,17 @@ def _springs(file: CarFile, rest_lengths, preloads):
     return jax.tree.map(lambda *x: jnp.stack(x), *laws)
 
 
-def load_car(path: str | Path | None = None, modes: int = 6, form: str = "library") -> Car:
+def load_car(path: str | Path | None = None, modes: int = 6, form: str = "fast") -> Car:
     """The car from a car file (default: the shipped ``car.toml``) with ``modes`` chassis
-    modes (0 = rigid chassis, up to 20). ``form``: ``"library"`` (this multibody car; the
-    fast fixed-structure form is a later addition).
+    modes (0 = rigid chassis, up to 20). ``form``: what manoeuvres integrate by default,
+    ``"fast"`` (the equations in minimal coordinates) or ``"library"`` (the multibody
+    system, the reference); both read the same :class:`CarParams`, and the set-up, rigs and
+    rates always use the multibody system.
 
     The springs' free lengths are set so that the car at rest on a flat road has every
     suspension at its design position (Tables B.2/B.3), see :func:`rest_spring_preloads`.
     """
-    if form != "library":
-        raise ParameterError(f"form = {form!r} is not available: allowed 'library'")
+    form = check_form(form)
     modes = _check_modes(modes)
     file = read_car_file(path)
     v = file.vehicle
@@ -403,7 +418,7 @@ def load_car(path: str | Path | None = None, modes: int = 6, form: str = "librar
         rack_ratio=as_float(file.sections["steering"]["rack_ratio"]),
     )
     system, template = _build_system(v, chassis)
-    car = Car(system=system, template=template, params=params, n_modes=modes)
+    car = Car(system=system, template=template, params=params, n_modes=modes, form=form)
     preloads = rest_spring_preloads(car)
     return eqx.tree_at(lambda c: c.params.springs, car, _springs(file, rest, preloads))
 

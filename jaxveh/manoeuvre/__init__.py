@@ -1,0 +1,20 @@
+"""Manoeuvres on the chapter-6 car: open-loop steering laws with a held speed
+(:mod:`._driver`), integration from straight running in the fast or the library form with
+named channels (:mod:`._simulate`, :mod:`._channels`)."""
+
+from ._channels import UNITS as UNITS, car_channels as car_channels
+from ._driver import (
+    AbstractSteeringLaw as AbstractSteeringLaw,
+    Manoeuvre as Manoeuvre,
+    RampSteer as RampSteer,
+    StepSteer as StepSteer,
+    SweptSine as SweptSine,
+    step_steer as step_steer,
+)
+from ._simulate import (
+    SOLVERS as SOLVERS,
+    CarRun as CarRun,
+    manoeuvre_channels as manoeuvre_channels,
+    save_times as save_times,
+    simulate as simulate,
+)

@@ -1,0 +1,86 @@
+"""Open-loop driver: steering-wheel angle laws (rad, positive to the left) and the
+manoeuvre they make with a held speed (section 6.1.5 "driver model"; the speed is held by
+the powertrain's PID, :class:`jaxveh.vehicle.SpeedPID`).
+
+Every law is an Equinox module with float leaves, so a manoeuvre is a pytree: its
+amplitude, timing and speed can be traced, swept with ``vmap`` and differentiated.
+"""
+
+import abc
+
+import equinox as eqx
+import jax.numpy as jnp
+from jaxtyping import Array, Float
+
+from ..params import Range, checked_field
+
+_ANGLE = Range(-3.0, 3.0, what="steering-wheel angle, rad")
+_TIME = Range(0.0, what="time, s")
+
+
+class AbstractSteeringLaw(eqx.Module):
+    """A steering-wheel angle history (rad, positive to the left)."""
+
+    @abc.abstractmethod
+    def __call__(self, t) -> Float[Array, ""]:
+        """Steering-wheel angle (rad) at time ``t`` (s)."""
+
+
+class StepSteer(AbstractSteeringLaw):
+    """The thesis's step (sections 3.3.3 and 7.4): 0 before ``start``, ``amplitude`` after
+    ``start + rise``, the cubic ``3 s^2 - 2 s^3`` between (continuous first derivative)."""
+
+    amplitude: Float[Array, ""] = checked_field("StepSteer.amplitude", _ANGLE)
+    start: Float[Array, ""] = checked_field("StepSteer.start", _TIME)
+    rise: Float[Array, ""] = checked_field("StepSteer.rise", Range(0.0, low_open=True, what="rise time, s"))
+
+    def __call__(self, t):
+        s = jnp.clip((t - self.start) / self.rise, 0.0, 1.0)
+        return self.amplitude * s * s * (3.0 - 2.0 * s)
+
+
+class RampSteer(AbstractSteeringLaw):
+    """Ramp steer (section 6.4.3): 0 before ``start``, then ``rate`` (rad/s) times the time
+    since ``start``, blended in over ``blend`` seconds (a quadratic) so that the rate is
+    continuous."""
+
+    rate: Float[Array, ""] = checked_field("RampSteer.rate", Range(-1.0, 1.0, what="steering-wheel rate, rad/s"))
+    start: Float[Array, ""] = checked_field("RampSteer.start", _TIME)
+    blend: Float[Array, ""] = checked_field("RampSteer.blend", Range(0.0, low_open=True, what="blend time, s"))
+
+    def __call__(self, t):
+        s = jnp.maximum(t - self.start, 0.0)
+        return self.rate * jnp.where(s < self.blend, 0.5 * s * s / self.blend, s - 0.5 * self.blend)
+
+
+class SweptSine(AbstractSteeringLaw):
+    """Swept sine (Fig. 6.15): ``amplitude sin(phase)`` from ``start``, the frequency rising
+    linearly from ``f0`` to ``f1`` (Hz) over ``sweep`` seconds."""
+
+    amplitude: Float[Array, ""] = checked_field("SweptSine.amplitude", _ANGLE)
+    f0: Float[Array, ""] = checked_field("SweptSine.f0", Range(0.0, what="start frequency, Hz"))
+    f1: Float[Array, ""] = checked_field("SweptSine.f1", Range(0.0, what="end frequency, Hz"))
+    sweep: Float[Array, ""] = checked_field("SweptSine.sweep", Range(0.0, low_open=True, what="sweep time, s"))
+    start: Float[Array, ""] = checked_field("SweptSine.start", _TIME)
+
+    def __call__(self, t):
+        s = jnp.clip(t - self.start, 0.0, self.sweep)
+        phase = 2.0 * jnp.pi * (self.f0 * s + 0.5 * (self.f1 - self.f0) * s * s / self.sweep)
+        return self.amplitude * jnp.sin(phase)
+
+
+class Manoeuvre(eqx.Module):
+    """An open-loop manoeuvre from straight running: the ``steering`` law, the ``speed``
+    held (m/s) and the ``duration`` (s)."""
+
+    steering: AbstractSteeringLaw
+    speed: Float[Array, ""] = checked_field("Manoeuvre.speed", Range(0.0, 100.0, low_open=True, what="speed, m/s"))
+    duration: Float[Array, ""] = checked_field("Manoeuvre.duration",
+                                               Range(0.0, 600.0, low_open=True, what="duration, s"))
+
+
+def step_steer(speed: float = 25.0, angle: float = 0.1, start: float = 0.5, rise: float = 0.2,
+               duration: float = 5.0) -> Manoeuvre:
+    """Step steer at ``speed`` (m/s; default 90 km/h as Fig. 7.6) to a steering-wheel
+    ``angle`` (rad, positive left), rising from ``start`` over ``rise`` seconds."""
+    return Manoeuvre(steering=StepSteer(amplitude=angle, start=start, rise=rise), speed=speed, duration=duration)

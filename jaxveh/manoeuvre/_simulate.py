@@ -1,0 +1,178 @@
+"""Integrate the car through a manoeuvre from straight running, in either form, and return
+named channels (:mod:`._channels`) at the save times.
+
+The start is :func:`jaxveh.vehicle.straight_running` at the manoeuvre's speed (the
+library car's trim, mapped to the fast car's minimal coordinates); the rack follows the
+steering law on top of the trim rack; the powertrain holds the speed. Both forms save on
+Diffrax's dense output (save times never force steps). :func:`manoeuvre_channels` is the
+pure, differentiable core; :func:`simulate` adds the checks, the wall time and the stop
+reason.
+"""
+
+import time
+
+import diffrax
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+from .. import multibody as mb
+from .._core import ParameterError
+from ..vehicle import (
+    ConstantSpeed,
+    FastState,
+    car_elements,
+    check_form,
+    fast_dynamics,
+    fast_model,
+    fast_state_from_library,
+    steering_rack,
+    straight_running,
+    system_params,
+)
+from ._channels import UNITS, car_channels
+from ._driver import Manoeuvre
+
+#: Solvers by name: explicit, and (see docs/manoeuvre.md) the fully implicit Kvaerno5.
+SOLVERS = ("tsit5", "kvaerno5")
+
+
+class CarRun(eqx.Module):
+    """A manoeuvre's result: save times ``ts`` (s), ``channels`` (name -> array with a
+    leading time axis, units in ``units``), the ``form`` that ran, the Diffrax step counts,
+    ``status`` (0 completed, 2 solver failure), ``stop_reason`` ("completed", the failure
+    and its time, or "traced" under ``jit``) and ``wall_s`` (s, after compilation when the
+    caller compiled first; NaN under ``jit``)."""
+
+    ts: Float[Array, " nt"]
+    channels: dict
+    steps: Array
+    rejected_steps: Array
+    status: Array
+    form: str = eqx.field(static=True)
+    stop_reason: str = eqx.field(static=True, default="traced")
+    wall_s: float = eqx.field(static=True, default=float("nan"))
+
+    @property
+    def units(self) -> dict:
+        return {k: UNITS.get(k, "m") for k in self.channels}
+
+
+def _solver(name: str):
+    if name == "tsit5":
+        return diffrax.Tsit5()
+    if name == "kvaerno5":
+        import optimistix as optx
+
+        return diffrax.Kvaerno5(root_finder=optx.Newton(rtol=1e-8, atol=1e-10))
+    raise ParameterError(f"solver = {name!r} is not available: allowed {', '.join(map(repr, SOLVERS))}")
+
+
+def _rack_law(car, manoeuvre: Manoeuvre, trim_rack):
+    return mb.TimeInputs(lambda t: trim_rack + steering_rack(car, manoeuvre.steering(t)))
+
+
+def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
+    law = _rack_law(car, manoeuvre, trim.rack)
+    params = system_params(car)
+    y0 = mb.joint_velocities(car.system, params, trim.static.q, trim.z, 0.0, law, 0.0, trim.aux)
+    s0 = fast_state_from_library(car, trim.static.q, y0, trim.aux)
+    model = fast_model(car)
+    elements = car_elements(car, ConstantSpeed(manoeuvre.speed))
+
+    def field(t, s, args):
+        d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
+        return FastState(d.q_dot, d.u_dot, d.aux_dot)
+
+    def save(t, s, args):
+        d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
+        out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], manoeuvre.steering(t))
+        return out | {"constraint_residual": d.link_residual}
+
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(field), _solver(solver), 0.0, manoeuvre.duration, None, s0,
+        saveat=diffrax.SaveAt(ts=ts, fn=save),
+        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol), max_steps=max_steps, throw=False)
+    return sol.ys, sol.stats, sol.result
+
+
+def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
+    law = _rack_law(car, manoeuvre, trim.rack)
+    elements = car_elements(car, ConstantSpeed(manoeuvre.speed))
+    c = car.system.body_names.index("chassis")
+    chassis = slice(car.system.q_offsets[c], car.system.q_offsets[c] + 6)
+
+    def outputs(t, state, dyn):
+        out = car_channels(car, elements, dyn.kinematics, state.aux, dyn.y[chassis], dyn.y_dot[chassis],
+                           manoeuvre.steering(t))
+        return out | {"constraint_residual": jnp.max(jnp.abs(dyn.projection.phi))}
+
+    sim = mb.simulate(car.system, system_params(car), trim.static.q, trim.z, 0.0, manoeuvre.duration, ts,
+                      inputs=law, elements=elements, aux0=trim.aux, outputs=outputs, solver=_solver(solver),
+                      rtol=rtol, atol=atol, max_steps=max_steps, throw=False)
+    return sim.outputs, sim.stats, sim.status
+
+
+def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, solver: str = "tsit5", rtol=1e-4,
+                       atol=1e-6, max_steps: int = 100_000):
+    """``(channels, stats, result)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
+    in ``form`` ("fast" or "library"), from ``trim`` (default: straight running at the
+    manoeuvre's speed): a pure function of the car and the manoeuvre (jit, vmap and grad
+    through it; reverse mode uses Diffrax's recursive checkpointing)."""
+    trim = straight_running(car, manoeuvre.speed) if trim is None else trim
+    run = _fast if form == "fast" else _library
+    return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps)
+
+
+# the trim and the run compile separately (one large program compiles far slower than two)
+_compiled_trim = eqx.filter_jit(straight_running)
+_compiled = eqx.filter_jit(manoeuvre_channels)
+
+
+def save_times(manoeuvre: Manoeuvre, points: int):
+    """``points`` evenly spaced save times over the manoeuvre (s)."""
+    return jnp.linspace(0.0, manoeuvre.duration, points)
+
+
+def _result_ok(form, result) -> tuple[int, str]:
+    if form == "fast":
+        ok = bool(result == diffrax.RESULTS.successful)
+        return (0, "completed") if ok else (2, f"solver failure: {diffrax.RESULTS[result]}")
+    status = int(result)
+    return status, "completed" if status == 0 else "solver failure"
+
+
+def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "tsit5",
+             rtol: float = 1e-4, atol: float | None = None, max_steps: int = 100_000, throw: bool = True) -> CarRun:
+    """Run ``manoeuvre`` on ``car`` (compiled once per car structure and solver) and return a
+    :class:`CarRun` with ``points`` save times. ``form``: "fast" or "library" (default: the
+    car's own, ``car.form``). ``rtol``/``atol``: the PID step-size controller's tolerances
+    (default ``atol = rtol / 100`` on every state: metres, radians, modal coordinates).
+    A failed solve raises ``RuntimeError`` naming the last time reached (``throw=False``:
+    the run is returned with ``status`` 2 and the unreached save times hold inf)."""
+    form = check_form(car.form if form is None else form)
+    _solver(solver)
+    if not (isinstance(points, int) and points >= 2):
+        raise ParameterError(f"points = {points!r} is out of range: allowed integers >= 2 (save times)")
+    if not 0.0 < rtol < 1.0:
+        raise ParameterError(f"rtol = {rtol!r} is out of range: allowed (0, 1)")
+    atol = rtol * 1e-2 if atol is None else atol
+    if not atol > 0.0:
+        raise ParameterError(f"atol = {atol!r} is out of range: allowed > 0")
+    ts = save_times(manoeuvre, points)
+    start = time.perf_counter()
+    trim = _compiled_trim(car, manoeuvre.speed)
+    channels, stats, result = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver, rtol=rtol,
+                                        atol=atol, max_steps=max_steps)
+    channels = jax.block_until_ready(channels)
+    wall = time.perf_counter() - start
+    status, reason = _result_ok(form, result)
+    if status:
+        reached = np.asarray(ts)[np.isfinite(np.asarray(channels["yaw_rate"]))]
+        reason = f"{reason} after t = {reached[-1] if reached.size else 0.0:.4g} s"
+        if throw:
+            raise RuntimeError(f"the {form} car's integration failed: {reason}")
+    return CarRun(ts=ts, channels=channels, steps=stats["num_steps"], rejected_steps=stats["num_rejected_steps"],
+                  status=jnp.asarray(status), form=form, stop_reason=reason, wall_s=wall)
