@@ -164,8 +164,10 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     ts = save_times(manoeuvre, points)
     start = time.perf_counter()
     trim = _compiled_trim(car, manoeuvre.speed)
-    channels, stats, result = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver, rtol=rtol,
-                                        atol=atol, max_steps=max_steps)
+    # tolerances as arrays: one compilation serves every tolerance
+    channels, stats, result = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
+                                        rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
+                                        max_steps=max_steps)
     channels = jax.block_until_ready(channels)
     wall = time.perf_counter() - start
     status, reason = _result_ok(form, result)

@@ -1,0 +1,233 @@
+"""Car benchmark (issue 11): the default 6-mode flexible car (2.5 % modal damping), a 5 s
+step steer at 90 km/h, in the fast form (minimal coordinates) against the library car and
+the CommonRoad multi-body model.
+
+Measures, through the public ``jaxveh.manoeuvre`` API: compile time (the straight-running
+trim plus the run), the run's wall time after compilation (best of three; the trim is
+timed beside it), steps, batches of step steers of different amplitude under ``jax.vmap``
+(sims/s), ``jax.grad`` of the yaw-rate overshoot w.r.t. every leaf of ``CarParams`` over
+the same function's forward time, the worst channel's difference from the library car
+(both at rtol 1e-8), the library car's wall time at the fast run's tolerance, and the
+CommonRoad multi-body model (PAC2002 tyres, SciPy RK45, its vehicle 2) through a step of
+the same road-wheel angle at the same speed when ``commonroad-vehicle-models`` is
+installed (``pip install 'jaxveh[bench]'``).
+
+    .venv/bin/python experiments/bench_car.py            # table
+    .venv/bin/python experiments/bench_car.py --json     # one JSON object on stdout
+    .venv/bin/python experiments/bench_car.py --quick    # batches 1 and 16, no gradient
+"""
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+import jaxveh  # noqa: F401  (float64)
+from jaxveh.manoeuvre import manoeuvre_channels, save_times, step_steer
+from jaxveh.vehicle import load_car, straight_running
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_engine import _plain  # noqa: E402
+
+SPEED = 25.0  # m/s (90 km/h, Fig. 7.6)
+ANGLE = np.deg2rad(6.0)  # steering-wheel step (rad): about 1.5 deg at the front wheels, ~1 g
+START, RISE, DURATION = 0.5, 0.2, 5.0  # s
+RTOL = 1e-4  # Table 7.2's tolerance
+REFERENCE_RTOL = 1e-8
+POINTS = 501
+BATCHES = (1, 16, 64, 256)
+#: Channels compared with the library car (the constraint residual differs by definition).
+COMPARED = ("speed", "ax", "ay", "yaw_rate", "sideslip", "roll", "pitch", "twist", "modes", "fz", "fx", "fy",
+            "slip_angle", "slip_ratio", "camber", "travel", "road_wheel_angle", "spring_length", "spring_force")
+
+
+def _timed(fn, *args):
+    t0 = time.perf_counter()
+    out = jax.block_until_ready(fn(*args))
+    return out, time.perf_counter() - t0
+
+
+def _best(fn, *args, repeats=3):
+    walls = [_timed(fn, *args)[1] for _ in range(repeats)]
+    return min(walls)
+
+
+def runner(form: str):
+    """Jitted ``(car, trim, angle, rtol) -> (channels, stats, result)``."""
+
+    def run(car, trim, angle, rtol):
+        m = step_steer(speed=SPEED, angle=angle, start=START, rise=RISE, duration=DURATION)
+        return manoeuvre_channels(car, m, save_times(m, POINTS), form=form, trim=trim, rtol=rtol, atol=rtol * 1e-2)
+
+    return eqx.filter_jit(run)
+
+
+def max_rel_error(a: dict, b: dict) -> tuple[float, str]:
+    """Worst channel: max |a - b| over max |b| (per channel)."""
+    worst, name = 0.0, ""
+    for k in COMPARED:
+        x, y = np.asarray(a[k]), np.asarray(b[k])
+        err = float(np.max(np.abs(x - y)) / max(np.max(np.abs(y)), 1e-300))
+        if err > worst:
+            worst, name = err, k
+    return worst, name
+
+
+def overshoot_fn(car):
+    """Yaw-rate overshoot of the step steer (fraction) as a function of ``CarParams``."""
+
+    def overshoot(params):
+        c = eqx.tree_at(lambda x: x.params, car, params)
+        m = step_steer(speed=SPEED, angle=ANGLE, start=START, rise=RISE, duration=DURATION)
+        ch, _, _ = manoeuvre_channels(c, m, save_times(m, POINTS), form="fast", rtol=RTOL, atol=RTOL * 1e-2)
+        r = ch["yaw_rate"]
+        return (jnp.max(r) - r[-1]) / r[-1]
+
+    return overshoot
+
+
+def bench_peer(delta: float) -> dict | None:
+    """CommonRoad multi-body model (29 states, PAC2002, vehicle 2): a cubic step of the
+    road-wheel angle ``delta`` (rad) over 0.5-0.7 s through a steering-rate servo (its input
+    is the steering velocity) at 90 km/h, SciPy RK45 at the fast run's tolerance."""
+    try:
+        from scipy.integrate import solve_ivp
+        from vehiclemodels.init_mb import init_mb
+        from vehiclemodels.parameters_vehicle2 import parameters_vehicle2
+        from vehiclemodels.vehicle_dynamics_mb import vehicle_dynamics_mb
+    except ImportError:
+        return None
+    p = _plain(parameters_vehicle2())
+    x0 = init_mb([0.0, 0.0, 0.0, SPEED, 0.0, 0.0, 0.0], p)
+
+    def target(t):
+        x = min(max((t - START) / RISE, 0.0), 1.0)
+        return delta * x * x * (3 - 2 * x), delta * 6 * x * (1 - x) / RISE
+
+    def rhs(t, x):
+        d, d_dot = target(t)
+        return vehicle_dynamics_mb(x, [d_dot + 20.0 * (d - x[2]), 0.0], p)
+
+    t0 = time.perf_counter()
+    sol = solve_ivp(rhs, (0.0, DURATION), x0, method="RK45", rtol=RTOL, atol=RTOL * 1e-2)
+    wall = time.perf_counter() - t0
+    return {"wall_s": wall, "nfev": int(sol.nfev), "success": bool(sol.success),
+            "final_yaw_rate_deg_s": float(np.degrees(sol.y[5, -1]))}
+
+
+def bench(quick: bool, log) -> dict:
+    car = load_car(modes=6)
+    res: dict = {}
+    trim_fn = eqx.filter_jit(straight_running)
+    trim, res["trim_compile_s"] = _timed(trim_fn, car, SPEED)
+    res["trim_s"] = _best(trim_fn, car, SPEED)
+    fast = runner("fast")
+    rtol = jnp.asarray(RTOL)
+    (ch, stats, result), first = _timed(fast, car, trim, ANGLE, rtol)
+    res["run_compile_s"] = first
+    res["compile_s"] = res["trim_compile_s"] + first
+    res["wall_s"] = _best(fast, car, trim, ANGLE, rtol)
+    res["steps"] = int(stats["num_steps"])
+    res["rejected_steps"] = int(stats["num_rejected_steps"])
+    r = np.asarray(ch["yaw_rate"])
+    res["response"] = {"final_yaw_rate_deg_s": float(r[-1]), "final_ay_g": float(ch["ay"][-1]),
+                       "yaw_rate_overshoot": float((r.max() - r[-1]) / r[-1]),
+                       "front_road_wheel_angle_deg": float(np.mean(np.asarray(ch["road_wheel_angle"])[-1, :2]))}
+    log(f"fast car: compile {res['compile_s']:.0f} s (trim {res['trim_compile_s']:.0f} s), run {res['wall_s']:.2f} s, "
+        f"{res['steps']} steps ({res['rejected_steps']} rejected), trim {res['trim_s']:.2f} s")
+
+    library = runner("library")
+    (_, lstats, _), res["library_compile_s"] = _timed(library, car, trim, ANGLE, rtol)
+    res["library_wall_s"] = _best(library, car, trim, ANGLE, rtol, repeats=2)
+    res["library_steps"] = int(lstats["num_steps"])
+    log(f"library car: run {res['library_wall_s']:.2f} s, {res['library_steps']} steps")
+    tight = jnp.asarray(REFERENCE_RTOL)
+    ref_fast, _, _ = fast(car, trim, ANGLE, tight)
+    ref_lib, _, _ = library(car, trim, ANGLE, tight)
+    res["max_rel_error_vs_library"], res["worst_channel"] = max_rel_error(ref_fast, ref_lib)
+    res["max_rel_error_vs_library_at_rtol"] = max_rel_error(ch, ref_lib)[0]
+    log(f"fast vs library (rtol {REFERENCE_RTOL:g}): worst channel {res['worst_channel']} "
+        f"{res['max_rel_error_vs_library']:.1e}; fast at rtol {RTOL:g} vs that: "
+        f"{res['max_rel_error_vs_library_at_rtol']:.1e}")
+
+    res["batch_sims_per_s"], res["batch_compile_s"] = {}, {}
+    batched = eqx.filter_jit(jax.vmap(lambda car, trim, angle, rtol: fast(car, trim, angle, rtol)[0]["yaw_rate"],
+                                      in_axes=(None, None, 0, None)))
+    for n in BATCHES[:2] if quick else BATCHES:
+        angles = jnp.linspace(0.5, 1.0, n) * ANGLE
+        _, res["batch_compile_s"][str(n)] = _timed(batched, car, trim, angles, rtol)
+        wall = _best(batched, car, trim, angles, rtol, repeats=2 if n <= 16 else 1)
+        res["batch_sims_per_s"][str(n)] = n / wall
+        log(f"batch {n}: {n / wall:.2f} sims/s")
+
+    if not quick:
+        overshoot = overshoot_fn(car)
+        forward = eqx.filter_jit(overshoot)
+        grad = eqx.filter_jit(eqx.filter_grad(overshoot))
+        _, res["forward_compile_s"] = _timed(forward, car.params)
+        res["forward_s"] = _best(forward, car.params)
+        g, res["grad_compile_s"] = _timed(grad, car.params)
+        res["grad_s"] = _best(grad, car.params, repeats=2)
+        res["grad_over_forward"] = res["grad_s"] / res["forward_s"]
+        res["grad_finite"] = bool(all(np.all(np.isfinite(x)) for x in jax.tree.leaves(g)))
+        log(f"gradient of the overshoot w.r.t. CarParams: {res['grad_s']:.2f} s = {res['grad_over_forward']:.1f} x "
+            f"forward ({res['forward_s']:.2f} s)")
+    else:
+        res["grad_over_forward"] = None
+
+    peer = bench_peer(np.deg2rad(res["response"]["front_road_wheel_angle_deg"]))
+    res["peer"] = peer
+    res["peer_wall_s"] = None if peer is None else peer["wall_s"]
+    return res
+
+
+KEYS = ("compile_s", "wall_s", "steps", "batch_sims_per_s", "grad_over_forward", "max_rel_error_vs_library",
+        "library_wall_s", "peer_wall_s")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout (progress on stderr)")
+    parser.add_argument("--quick", action="store_true", help="batches 1 and 16 only, no gradient (smoke test)")
+    parser.add_argument("--out", type=Path, help="also write bench_car.json into this folder")
+    args = parser.parse_args()
+
+    def log(msg):
+        print(msg, file=sys.stderr if args.json else sys.stdout, flush=True)
+
+    t0 = time.perf_counter()
+    res = bench(args.quick, log)
+    res["total_s"] = time.perf_counter() - t0
+    summary = {k: res[k] for k in KEYS} | {"details": {k: v for k, v in res.items() if k not in KEYS}}
+    if args.out is not None:
+        args.out.mkdir(parents=True, exist_ok=True)
+        (args.out / "bench_car.json").write_text(json.dumps(summary, indent=2))
+    if args.json:
+        print(json.dumps(summary))
+        return
+    peer = res["peer_wall_s"]
+    rows = [
+        ("compile (trim + run)", f"{res['compile_s']:.0f} s", "<= 30 s"),
+        ("5 s step steer, fast car", f"{res['wall_s']:.2f} s, {res['steps']} steps", "<= 0.1 s, <= peer / 2"),
+        ("trim (straight running)", f"{res['trim_s']:.2f} s", ""),
+        ("library car, same tolerance", f"{res['library_wall_s']:.2f} s", ""),
+        ("CommonRoad MB, RK45", "not installed" if peer is None else f"{peer:.2f} s", ""),
+        *((f"batch {n}", f"{v:.2f} sims/s", ">= 50 sims/s") for n, v in res["batch_sims_per_s"].items()),
+        ("grad / forward", "skipped" if res["grad_over_forward"] is None else f"{res['grad_over_forward']:.1f}",
+         "<= 5"),
+        ("worst channel vs library", f"{res['max_rel_error_vs_library']:.1e} ({res['worst_channel']})", "<= 1e-5"),
+        ("thesis Table 7.2 (2008 CPU)", "0.9 s flexible, 0.7 s rigid", ""),
+    ]
+    for name, value, target in rows:
+        print(f"{name:<30}{value:<34}{target}")
+    print(f"total {res['total_s']:.0f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,123 @@
+"""Manoeuvres: steering laws, argument checks, and the 5 s step steer of the fast car against
+the library car (every channel, and the flexible-minus-rigid difference)."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxveh._core import GRAVITY, ParameterError
+from jaxveh.manoeuvre import UNITS, RampSteer, StepSteer, SweptSine, simulate, step_steer
+from jaxveh.vehicle import load_car
+
+ANGLE = np.deg2rad(6.0)
+TIGHT = 1e-8
+
+
+# ---- steering laws ---------------------------------------------------------------------------
+
+
+def test_step_steer_is_the_thesis_cubic():
+    law = StepSteer(amplitude=0.1, start=0.5, rise=0.2)
+    ts = jnp.asarray([0.0, 0.5, 0.6, 0.7, 3.0])
+    np.testing.assert_allclose(jax.vmap(law)(ts), [0.0, 0.0, 0.05, 0.1, 0.1], atol=1e-15)
+    rate = jax.vmap(jax.grad(law))
+    # continuous first derivative: zero at both ends of the rise, 1.5 A / rise in the middle
+    np.testing.assert_allclose(rate(jnp.asarray([0.5, 0.6, 0.7])), [0.0, 0.75, 0.0], atol=1e-12)
+
+
+def test_ramp_and_sweep():
+    ramp = RampSteer(rate=0.2, start=1.0, blend=0.1)
+    np.testing.assert_allclose(jax.grad(ramp)(3.0), 0.2, rtol=1e-12)
+    np.testing.assert_allclose(ramp(3.0), 0.2 * (2.0 - 0.05), rtol=1e-12)
+    assert float(jax.grad(ramp)(1.0)) == 0.0
+    sweep = SweptSine(amplitude=0.1, f0=0.0, f1=15.0, sweep=10.0, start=0.0)
+    # instantaneous frequency (Hz) = phase rate / 2 pi: linear from f0 to f1
+    phase_rate = jax.grad(lambda t: jnp.arcsin(sweep(t) / 0.1))(0.01)
+    np.testing.assert_allclose(phase_rate / (2 * np.pi), 0.015, rtol=1e-6)
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: StepSteer(amplitude=0.1, start=0.5, rise=0.0), "StepSteer.rise"),
+    (lambda: StepSteer(amplitude=5.0, start=0.5, rise=0.2), "StepSteer.amplitude"),
+    (lambda: step_steer(speed=-1.0), "Manoeuvre.speed"),
+    (lambda: step_steer(duration=0.0), "Manoeuvre.duration"),
+    (lambda: SweptSine(amplitude=0.1, f0=-1.0, f1=1.0, sweep=1.0, start=0.0), "SweptSine.f0"),
+])
+def test_bad_manoeuvres_are_refused(make, match):
+    with pytest.raises(ParameterError, match=match):
+        make()
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"form": "quick"}, "form = 'quick'"),
+    ({"solver": "euler"}, "solver = 'euler'"),
+    ({"points": 1}, "points = 1"),
+    ({"rtol": 0.0}, "rtol = 0.0"),
+    ({"atol": -1.0}, "atol = -1.0"),
+])
+def test_bad_simulate_arguments_are_refused(kwargs, match):
+    with pytest.raises(ParameterError, match=match):
+        simulate(load_car(modes=0), step_steer(), **kwargs)
+
+
+# ---- the step steer: fast car against library car ------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def runs():
+    """The 5 s step steer at 90 km/h (6 deg at the steering wheel, about 1 g), flexible (6
+    modes) and rigid, each in both forms, at rtol 1e-8."""
+    out = {}
+    for modes in (6, 0):
+        car = load_car(modes=modes)
+        for form in ("fast", "library"):
+            out[modes, form] = simulate(car, step_steer(angle=ANGLE), form=form, rtol=TIGHT, points=251)
+    return out
+
+
+def _channels(run):
+    return {k: np.asarray(v) for k, v in run.channels.items() if k != "constraint_residual"}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("modes", [6, 0])
+def test_step_steer_fast_equals_library(runs, modes):
+    fast, lib = _channels(runs[modes, "fast"]), _channels(runs[modes, "library"])
+    assert set(fast) == set(UNITS)
+    for name in fast:
+        scale = np.max(np.abs(lib[name]))
+        assert np.max(np.abs(fast[name] - lib[name])) <= 1e-5 * scale, name
+
+
+@pytest.mark.slow
+def test_flexible_minus_rigid_agrees(runs):
+    """The chassis's effect on every channel is the same in both forms to 1 % of its size."""
+    checked = 0
+    for name in _channels(runs[6, "fast"]):
+        if name == "modes":
+            continue
+        d_fast = _channels(runs[6, "fast"])[name] - _channels(runs[0, "fast"])[name]
+        d_lib = _channels(runs[6, "library"])[name] - _channels(runs[0, "library"])[name]
+        size = np.max(np.abs(d_lib))
+        if size <= 1e-9 * np.max(np.abs(_channels(runs[0, "library"])[name])):
+            continue  # the chassis does not move this channel (the steering input)
+        assert np.max(np.abs(d_fast - d_lib)) <= 0.01 * size, name
+        checked += 1
+    assert checked >= 15
+
+
+@pytest.mark.slow
+def test_step_steer_physics(runs):
+    """Steady state at the end: ay = V r / g, speed held, links closed, no NaN."""
+    for (modes, _form), run in runs.items():
+        ch = _channels(run)
+        assert run.stop_reason == "completed" and int(run.status) == 0
+        assert all(np.all(np.isfinite(v)) for v in ch.values())
+        v, r, ay = ch["speed"][-1], np.deg2rad(ch["yaw_rate"][-1]), ch["ay"][-1]
+        np.testing.assert_allclose(ay, v * r / GRAVITY, rtol=2e-3)
+        assert abs(ch["speed"][-1] - 25.0) < 0.05
+        assert 0.5 < ay < 1.5
+        assert float(np.max(np.asarray(run.channels["constraint_residual"]))) < 1e-9
+        if modes == 0:
+            assert np.all(ch["twist"] == 0.0)
