@@ -1,12 +1,16 @@
 """Manoeuvres: steering laws, argument checks, and the 5 s step steer of the fast car against
 the library car (every channel, and the flexible-minus-rigid difference)."""
 
+import json
+
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from jaxveh._core import GRAVITY, ParameterError
+from jaxveh.cli import app
 from jaxveh.manoeuvre import UNITS, RampSteer, StepSteer, SweptSine, simulate, step_steer
 from jaxveh.vehicle import load_car
 
@@ -72,7 +76,7 @@ def runs():
     for modes in (6, 0):
         car = load_car(modes=modes)
         for form in ("fast", "library"):
-            out[modes, form] = simulate(car, step_steer(angle=ANGLE), form=form, rtol=TIGHT, points=251)
+            out[modes, form] = simulate(car, step_steer(angle=ANGLE), form=form, rtol=TIGHT)
     return out
 
 
@@ -121,3 +125,38 @@ def test_step_steer_physics(runs):
         assert float(np.max(np.asarray(run.channels["constraint_residual"]))) < 1e-9
         if modes == 0:
             assert np.all(ch["twist"] == 0.0)
+
+
+# ---- CLI ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--speed-kmh", "0"], "--speed-kmh must be > 0"),
+    (["--form", "quick"], "form = 'quick'"),
+    (["--steer-deg", "500"], "StepSteer.amplitude"),
+    (["--modes", "21"], "modes = 21"),
+])
+def test_cli_refuses_bad_options(args, match):
+    result = CliRunner().invoke(app, ["simulate", "step-steer", *args])
+    assert result.exit_code == 2
+    assert match in result.output
+
+
+@pytest.mark.slow
+def test_cli_step_steer_json_and_files(runs, tmp_path):
+    """The contract keys, and the same numbers as the Python API (the rigid fast car)."""
+    result = CliRunner().invoke(app, ["simulate", "step-steer", "--rigid", "--speed-kmh", "90", "--rtol", "1e-8",
+                                      "--json", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    for key in ("wall_time_s", "steps", "max_constraint_residual_m", "yaw_rate_response_time_s",
+                "yaw_rate_overshoot_pct", "yaw_rate_steady_deg_s", "ay_steady_g"):
+        assert np.isfinite(out[key]), key
+    run = runs[0, "fast"]
+    np.testing.assert_allclose(out["yaw_rate_steady_deg_s"], np.mean(np.asarray(run.channels["yaw_rate"])[-51:]),
+                               rtol=1e-9)
+    assert 0.05 < out["yaw_rate_response_time_s"] < 0.5
+    assert out["max_constraint_residual_m"] < 1e-9
+    assert {p.name for p in tmp_path.iterdir()} == {"step_steer.json", "step_steer.csv", "step_steer.png"}
+    header = (tmp_path / "step_steer.csv").read_text().splitlines()[0].split(",")
+    assert header[:3] == ["t_s", "steering_wheel_angle_deg", "speed_m/s"]

@@ -6,6 +6,7 @@ from ._analytic import app as analytic_app
 from ._chassis import app as chassis_app
 from ._multibody import app as multibody_app
 from ._run import run as run_command
+from ._simulate import app as simulate_app
 from ._tyre import app as tyre_app
 from ._vehicle import rig_app, vehicle_app
 
@@ -21,6 +22,7 @@ app.add_typer(chassis_app, name="chassis")
 app.add_typer(multibody_app, name="multibody")
 app.add_typer(vehicle_app, name="vehicle")
 app.add_typer(rig_app, name="rig")
+app.add_typer(simulate_app, name="simulate")
 
 
 def main() -> None:

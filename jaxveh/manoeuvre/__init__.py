@@ -11,6 +11,7 @@ from ._driver import (
     SweptSine as SweptSine,
     step_steer as step_steer,
 )
+from ._metrics import step_steer_metrics as step_steer_metrics
 from ._simulate import (
     SOLVERS as SOLVERS,
     CarRun as CarRun,

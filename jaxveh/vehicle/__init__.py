@@ -19,8 +19,8 @@ from ._aero import (
 )
 from ._car import (
     CORNER_KEYS as CORNER_KEYS,
-    FORMS as FORMS,
     CORNERS as CORNERS,
+    FORMS as FORMS,
     MAX_MODES as MAX_MODES,
     Car as Car,
     CarParams as CarParams,

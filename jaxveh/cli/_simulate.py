@@ -1,0 +1,168 @@
+"""``jaxveh simulate``: open-loop manoeuvres of the 14-DOF car (fast or library form)."""
+
+import math
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from .._core import ParameterError
+from ._common import emit_json, fail, write_json
+
+app = typer.Typer(help="Manoeuvres of the 14-DOF car with its flexible chassis.", no_args_is_help=True)
+
+VehicleOpt = typer.Option(None, "--vehicle", help="car TOML file (default: the shipped car.toml)")
+ModesOpt = typer.Option(6, "--modes", help="chassis modes, 0 (rigid) to 20")
+RigidOpt = typer.Option(False, "--rigid", help="rigid chassis (same as --modes 0)")
+FormOpt = typer.Option("fast", "--form", help="fast (minimal coordinates) or library (the multibody reference)")
+SpeedOpt = typer.Option(90.0, "--speed-kmh", help="speed held by the powertrain, km/h")
+RtolOpt = typer.Option(1e-4, "--rtol", help="relative tolerance of the step-size controller")
+JsonOpt = typer.Option(False, "--json", help="print only JSON on stdout")
+OutOpt = typer.Option(None, "--out", help="write JSON, CSV and a PNG into this folder")
+QuietOpt = typer.Option(False, "--quiet", help="no progress messages on stderr")
+
+
+def _compilation_cache() -> None:
+    """Keep compiled programs between runs (the car's first compilation takes minutes)."""
+    import jax
+
+    folder = Path(os.environ.get("JAXVEH_CACHE", Path.home() / ".cache" / "jaxveh" / "jax"))
+    jax.config.update("jax_compilation_cache_dir", str(folder))
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
+
+
+def _say(quiet: bool, message: str) -> None:
+    if not quiet and sys.stderr.isatty():
+        typer.echo(message, err=True)
+
+
+def _write(out_dir: Path, name: str, run, report: dict) -> None:
+    from .. import plots
+
+    out_dir = Path(out_dir)
+    write_json(report, out_dir / f"{name}.json")
+    columns, header = [np.asarray(run.ts)], ["t_s"]
+    for key, values in run.channels.items():
+        v = np.asarray(values)
+        unit = run.units[key]
+        if v.ndim == 1:
+            columns.append(v)
+            header.append(f"{key}_{unit}")
+        else:
+            labels = ("fl", "fr", "rl", "rr") if v.shape[1] == 4 and key != "modes" else range(1, v.shape[1] + 1)
+            for k, label in enumerate(labels):
+                columns.append(v[:, k])
+                header.append(f"{key}_{label}_{unit}")
+    np.savetxt(out_dir / f"{name}.csv", np.column_stack(columns), delimiter=",", header=",".join(header),
+               comments="")
+    history = {"t_s": np.asarray(run.ts)} | {k: np.asarray(v) for k, v in run.channels.items()}
+    plots.save(plots.plot_manoeuvre({report["chassis"]: history}, title=report["title"]), out_dir / f"{name}.png")
+
+
+def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics=None):
+    from ..manoeuvre import simulate
+    from ..vehicle import load_car
+
+    _compilation_cache()
+    modes = 0 if rigid else modes
+    try:
+        car = load_car(vehicle, modes=modes, form=form)
+        _say(quiet, f"jaxveh: {name}, {modes} chassis modes, {form} form (the first run compiles for minutes)")
+        run = simulate(car, manoeuvre, rtol=rtol)
+    except (ParameterError, RuntimeError) as e:
+        fail(str(e))
+    report = {
+        "manoeuvre": name,
+        "form": form,
+        "modes": modes,
+        "chassis": "rigid" if modes == 0 else f"flexible, {modes} modes",
+        "speed_kmh": float(manoeuvre.speed) * 3.6,
+        "duration_s": float(manoeuvre.duration),
+        "rtol": rtol,
+        "wall_time_s": run.wall_s,
+        "steps": int(run.steps),
+        "rejected_steps": int(run.rejected_steps),
+        "max_constraint_residual_m": float(np.max(np.asarray(run.channels["constraint_residual"]))),
+        "stop_reason": run.stop_reason,
+    }
+    if metrics is not None:
+        report |= metrics(run)
+    report["title"] = f"{name} at {report['speed_kmh']:g} km/h, {report['chassis']} ({form} form)"
+    if out_dir is not None:
+        _write(out_dir, name.replace("-", "_"), run, report)
+    if as_json:
+        emit_json(report)
+        return
+    typer.echo(f"{report['title']}: {report['wall_time_s']:.2f} s (compilation included on a first run), "
+               f"{report['steps']} steps" + (f"; wrote {out_dir}" if out_dir else ""))
+    for key, value in report.items():
+        if key.endswith(("_s", "_pct", "_deg_s", "_g", "_deg")) and key not in ("wall_time_s", "duration_s"):
+            typer.echo(f"  {key} = {value:.4g}")
+
+
+def _speed(speed_kmh: float) -> float:
+    if not speed_kmh > 0.0:
+        fail(f"--speed-kmh must be > 0 (the manoeuvre holds a speed), got {speed_kmh:g}")
+    return speed_kmh / 3.6
+
+
+@app.command("step-steer")
+def step_steer(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    speed_kmh: float = SpeedOpt,
+    steer_deg: float = typer.Option(6.0, "--steer-deg", help="final steering-wheel angle, deg (negative: right)"),
+    duration: float = typer.Option(5.0, "--duration", help="s"),
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+) -> None:
+    """Step steer (Fig. 7.6): the steering wheel turns to --steer-deg between 0.5 and 0.7 s
+    (a cubic with continuous rate) at a held speed; yaw-rate response time, overshoot and
+    steady values."""
+    from ..manoeuvre import step_steer as make, step_steer_metrics
+
+    try:
+        m = make(speed=_speed(speed_kmh), angle=math.radians(steer_deg), duration=duration)
+    except ParameterError as e:
+        fail(str(e))
+    _run("step-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet,
+         lambda run: step_steer_metrics(run.ts, run.channels, m.steering))
+
+
+@app.command("ramp-steer")
+def ramp_steer(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    speed_kmh: float = typer.Option(40.0, "--speed-kmh", help="speed held, km/h (Fig. 6.13: 40)"),
+    rate_deg_s: float = typer.Option(4.0, "--rate-deg-s", help="steering-wheel rate, deg/s (negative: right)"),
+    duration: float = typer.Option(10.0, "--duration", help="s"),
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+) -> None:
+    """Ramp steer (Fig. 6.13): the steering wheel turns at a constant rate from 0.5 s."""
+    from ..manoeuvre import Manoeuvre, RampSteer
+
+    try:
+        law = RampSteer(rate=math.radians(rate_deg_s), start=0.5, blend=0.1)
+        m = Manoeuvre(steering=law, speed=_speed(speed_kmh), duration=duration)
+    except ParameterError as e:
+        fail(str(e))
+    _run("ramp-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet)
+
+
+@app.command("sine-sweep")
+def sine_sweep(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    speed_kmh: float = SpeedOpt,
+    steer_deg: float = typer.Option(5.0, "--steer-deg", help="steering-wheel amplitude, deg (Fig. 6.15: 5)"),
+    f_max: float = typer.Option(15.0, "--f-max", help="end frequency, Hz (Fig. 6.15: 15)"),
+    duration: float = typer.Option(20.0, "--duration", help="sweep time, s"),
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+) -> None:
+    """Swept sine (Fig. 6.15): frequency rising linearly from 0 to --f-max over --duration."""
+    from ..manoeuvre import Manoeuvre, SweptSine
+
+    try:
+        law = SweptSine(amplitude=math.radians(steer_deg), f0=0.0, f1=f_max, sweep=duration, start=0.0)
+        m = Manoeuvre(steering=law, speed=_speed(speed_kmh), duration=duration)
+    except ParameterError as e:
+        fail(str(e))
+    _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet)

@@ -1,0 +1,41 @@
+"""Time histories of the car's manoeuvres (Fig. 7.6 style): runs overlaid by label."""
+
+import numpy as np
+
+from ._chapter3 import figure
+
+#: Panels: channel, axis label, which element of a per-corner channel (None: scalar).
+_PANELS = (
+    ("steering_wheel_angle", "δsw [deg]", None),
+    ("ay", "ay [g]", None),
+    ("yaw_rate", "r [deg/s]", None),
+    ("roll", "roll [deg]", None),
+    ("sideslip", "β [deg]", None),
+    ("modes", "modal coordinates [-]", "all"),
+)
+
+
+def plot_manoeuvre(runs: dict, title: str = "", t_max: float | None = None):
+    """Steering, ay, yaw rate, roll, sideslip and the modal coordinates of one or more runs
+    (``{label: {"t_s": ..., channel: ...}}``, channels as from
+    :func:`jaxveh.manoeuvre.simulate`)."""
+    fig, axes = figure(3, 2, figsize=(10, 9))
+    styles = ("-", "--", "-.", ":")
+    for ax, (key, ylabel, which) in zip(axes.flat, _PANELS):
+        for (label, run), style in zip(runs.items(), styles):
+            y = np.asarray(run[key])
+            if which == "all":
+                for k in range(y.shape[1] if y.ndim == 2 else 0):
+                    ax.plot(run["t_s"], y[:, k], style, label=f"{label} mode {k + 1}")
+            else:
+                ax.plot(run["t_s"], y, style, label=label)
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel(ylabel)
+        if t_max is not None:
+            ax.set_xlim(0, t_max)
+        ax.grid(True, alpha=0.3)
+        if ax.lines:
+            ax.legend(fontsize=7, ncols=2 if which == "all" else 1)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
