@@ -3,6 +3,7 @@ the library car (every channel, and the flexible-minus-rigid difference)."""
 
 import json
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -160,3 +161,51 @@ def test_cli_step_steer_json_and_files(runs, tmp_path):
     assert {p.name for p in tmp_path.iterdir()} == {"step_steer.json", "step_steer.csv", "step_steer.png"}
     header = (tmp_path / "step_steer.csv").read_text().splitlines()[0].split(",")
     assert header[:3] == ["t_s", "steering_wheel_angle_deg", "speed_m/s"]
+
+
+# ---- one parameter pytree: the same sensitivities in both forms ---------------------------------
+
+KNOBS = {
+    "front anti-roll bar": (lambda p: p.arb_rates, lambda x: x.at[0].multiply(1.0 + 1e-3)),
+    "hard point A z (front)": (lambda p: p.vehicle.hard_points_front.points, lambda x: x.at[0, 2].add(1e-4)),
+    "modal stiffness (mode 1)": (lambda p: p.chassis.stiffness_scale, lambda x: x.at[0].multiply(1.0 + 1e-3)),
+}
+
+
+def _step_metrics(run):
+    """Yaw rate at 1 s (transient, deg/s) and the final ay (g)."""
+    ch = run.channels
+    i = int(np.argmin(np.abs(np.asarray(run.ts) - 1.0)))
+    return np.asarray([ch["yaw_rate"][i], ch["ay"][-1]])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("knob", list(KNOBS))
+def test_step_steer_sensitivities_agree_between_forms(runs, knob):
+    """Central differences of two step-steer metrics w.r.t. an anti-roll bar rate, a hard
+    point and a modal stiffness multiplier: every leaf changes both forms the same way."""
+    where, step = KNOBS[knob]
+    car = load_car(modes=6)
+    leaf = where(car.params)
+    delta = step(leaf) - leaf
+    slopes = {}
+    for form in ("fast", "library"):
+        plus, minus = (simulate(eqx.tree_at(lambda c: where(c.params), car, leaf + s * delta), step_steer(angle=ANGLE),
+                                form=form, rtol=TIGHT) for s in (1.0, -1.0))
+        slopes[form] = (_step_metrics(plus) - _step_metrics(minus)) / 2.0
+    base = _step_metrics(runs[6, "library"])
+    assert np.all(np.abs(slopes["library"]) > 1e-7 * np.abs(base)), knob  # the knob moves the response
+    np.testing.assert_allclose(slopes["fast"], slopes["library"], rtol=1e-2, err_msg=knob)
+
+
+@pytest.mark.slow
+def test_stiff_chassis_tends_to_the_rigid_car(runs):
+    """Modal stiffness x 100: the flexible car's difference from the rigid car shrinks
+    about a hundredfold (the chassis's effect scales with its compliance)."""
+    car = load_car(modes=6)
+    stiff = eqx.tree_at(lambda c: c.params.chassis.stiffness_scale, car, car.params.chassis.stiffness_scale * 100.0)
+    run = simulate(stiff, step_steer(angle=ANGLE), rtol=1e-6)
+    rigid, flexible = _channels(runs[0, "fast"]), _channels(runs[6, "fast"])
+    for name in ("ay", "yaw_rate", "roll", "sideslip", "fz"):
+        gap = np.max(np.abs(np.asarray(run.channels[name]) - rigid[name]))
+        assert gap < 0.03 * np.max(np.abs(flexible[name] - rigid[name])), name

@@ -39,6 +39,9 @@ from ._driver import Manoeuvre
 #: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; KenCarp4 IMEX with the
 #: chassis modes' linearised dynamics implicit; the fully implicit Kvaerno5.
 SOLVERS = ("tsit5", "kencarp4", "kvaerno5")
+#: First step (s): given rather than estimated, which would compile two more copies of the
+#: vector field; the controller adapts it from the first step on.
+FIRST_STEP = 1e-3
 
 
 class CarRun(eqx.Module):
@@ -97,7 +100,7 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
 
     terms = _imex_terms(field, s0, car.n_modes) if solver == "kencarp4" else diffrax.ODETerm(field)
     sol = diffrax.diffeqsolve(
-        terms, _solver(solver), 0.0, manoeuvre.duration, None, s0,
+        terms, _solver(solver), 0.0, manoeuvre.duration, FIRST_STEP, s0,
         saveat=diffrax.SaveAt(ts=ts, fn=save),
         stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol), max_steps=max_steps, throw=False)
     return sol.ys, sol.stats, sol.result
@@ -140,7 +143,8 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
 
     sim = mb.simulate(car.system, system_params(car), trim.static.q, trim.z, 0.0, manoeuvre.duration, ts,
                       inputs=law, elements=elements, aux0=trim.aux, outputs=outputs, solver=_solver(solver),
-                      rtol=rtol, atol=atol, max_steps=max_steps, implicit_modes=solver == "kencarp4", throw=False)
+                      rtol=rtol, atol=atol, dt0=FIRST_STEP, max_steps=max_steps,
+                      implicit_modes=solver == "kencarp4", throw=False)
     return sim.outputs, sim.stats, sim.status
 
 
