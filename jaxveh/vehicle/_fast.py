@@ -24,6 +24,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.scipy.linalg import cho_factor, cho_solve
 from jaxtyping import Array, Float
 
 from ..multibody import Kinematics, SystemParams, body_forces, element_forces, input_state, rotation_matrix
@@ -39,6 +40,7 @@ from ._corner_kinematics import (
     corner_motion,
     pose_residual,
 )
+from ._fast_suspension import split_suspensions, suspension_forces
 
 _EY = ((0.0, 1.0, 0.0),)  # the spin axis, as a row
 
@@ -255,10 +257,15 @@ class FastDynamics(eqx.Module):
 
 def coordinate_rates(car: Car, q, u):
     """``q_dot`` from ``(q, u)``: chassis position rate in global axes, angle rates from the
-    body angular velocity (``"zyx"``), modal, travel and spin rates."""
+    body angular velocity (``"zyx"``, the inverse of its rate matrix in closed form), modal,
+    travel and spin rates."""
     angles = q[3:6]
     r_dot = rotation_matrix("zyx", angles) @ u[:3]
-    angle_rates = jnp.linalg.solve(angular_velocity_matrix("zyx", angles), u[3:6])
+    pitch, roll = angles[1], angles[2]
+    wx, wy, wz = u[3], u[4], u[5]
+    lateral = wy * jnp.sin(roll) + wz * jnp.cos(roll)
+    angle_rates = jnp.stack([lateral / jnp.cos(pitch), wy * jnp.cos(roll) - wz * jnp.sin(roll),
+                             wx + lateral * jnp.tan(pitch)])
     return jnp.concatenate([r_dot, angle_rates, u[6:]])
 
 
@@ -297,7 +304,11 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     origins, rotations = _body_frames(car, lay, m, r_up, a_up, a_wh)
     kin = Kinematics(t=t, q=q, v=u, u=rack_v, u_dot=rack_dot_v, origins=origins, rotations=rotations, x=x, xd=xd,
                      point_rotations=rots, point_omega=om, modal=_modal_values(car, q))
-    forces, torques, aux_dot = element_forces(system, params, elements, kin, aux)
+    # the push-rod suspensions (no auxiliary states) as one four-corner computation
+    suspensions, others = split_suspensions(elements)
+    forces, torques, aux_dot = element_forces(system, params, others, kin, aux)
+    if suspensions is not None:
+        forces = forces + suspension_forces(suspensions, kin)
     rack_acc = _rack(system, law, t, q, aux, q_dot, aux_dot)[0] if system.n_inputs else jnp.zeros_like(rack)
     # the rack acceleration enters the corners' velocity-product terms linearly
     m = eqx.tree_at(lambda x: x.corners.w_acc0, m, m.corners.w_acc0 + m.corners.sens[:, :, 1] * rack_acc)
@@ -334,7 +345,7 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
         "kia,kij,kjb->ab", jac_w, inertia, jac_w) + jnp.einsum("ka,k,kb->ab", jac_wh[:, 1], spin, jac_wh[:, 1])
     rhs = rhs + jnp.einsum("kia,ki->a", jac_v, f_up) + jnp.einsum("kia,ki->a", jac_w, t_up) + jnp.einsum(
         "kia,ki->a", jac_wh, t_wh)
-    u_dot = jnp.linalg.solve(m_red, rhs)
+    u_dot = cho_solve(cho_factor(m_red), rhs)  # symmetric positive definite
     residual = pose_residual(model.geometry, split(car, q)[1], rack, q[6:6 + car.n_modes], m.corners.w)
     return FastDynamics(q_dot=q_dot, u_dot=u_dot, aux_dot=aux_dot, rack=rack, rack_rate=rack_rate, kinematics=kin,
                         link_residual=residual)

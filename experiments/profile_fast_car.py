@@ -1,0 +1,128 @@
+"""Cost of the fast car's vector field, piece by piece: top-level XLA operations of each
+compiled piece (the ENTRY computation, counted by kind; on XLA CPU the cost follows their
+number, not the flops) and its time per evaluation inside a compiled loop (best of
+``--repeats``; the loop removes the dispatch overhead of one call).
+
+Pieces: the kinematic map's guess, the corner poses, the corner motion, the car motion,
+the ``Kinematics`` for the force elements, each of the library car's force elements, the
+fast car's four-corner push-rod suspension (:mod:`jaxveh.vehicle._fast_suspension`) and the
+full evaluation (``q_dot``, ``u_dot``, ``aux_dot``).
+
+    .venv/bin/python experiments/profile_fast_car.py [--json results/profile_fast_car.json]
+"""
+
+import argparse
+import collections
+import json
+import re
+import time
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+
+import jaxveh  # noqa: F401  (float64)
+import jaxveh.multibody as mb
+from jaxveh.vehicle import (
+    ConstantSpeed,
+    _corner_kinematics as ck,
+    _fast as fast,
+    _fast_suspension as fs,
+    car_elements,
+    load_car,
+    steering,
+)
+
+LOOP = 200
+
+
+def entry_ops(f, *args) -> collections.Counter:
+    """Top-level operations of the compiled ``f`` (its ENTRY computation) by kind."""
+    text = jax.jit(f).lower(*args).compile().as_text()
+    entry = text.split("\nENTRY")[1]
+    return collections.Counter(re.findall(r"= \S+ ([\w-]+)\(", entry))
+
+
+def loop_time(f, *args, repeats: int) -> float:
+    """Seconds per evaluation of ``f`` inside a compiled loop of ``LOOP`` (best of
+    ``repeats``); each iteration's first argument moves by 1e-30 of the previous output's
+    sum, so nothing is hoisted out of the loop."""
+
+    def nudge(x, acc):
+        return jax.tree.map(lambda leaf: leaf + 1e-30 * acc if jnp.issubdtype(leaf.dtype, jnp.floating) else leaf, x)
+
+    def loop(*a):
+        def body(_, acc):
+            out = f(nudge(a[0], acc), *a[1:])
+            return sum(jnp.sum(leaf) for leaf in jax.tree.leaves(out))
+
+        return jax.lax.fori_loop(0, LOOP, body, jnp.zeros(()))
+
+    run = jax.jit(loop)
+    jax.block_until_ready(run(*args))
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        jax.block_until_ready(run(*args))
+        best = min(best, (time.perf_counter() - t0) / LOOP)
+    return best
+
+
+def pieces():
+    """``(name, function, arguments)`` of every piece at one state of the library car."""
+    car = load_car(modes=6)
+    elements = car_elements(car, ConstantSpeed(25.0))
+    inputs = steering(car, lambda t: 0.05 * jnp.sin(3.0 * t) + 0.02)
+    model = jax.jit(fast.fast_model)(car)
+    n = 14 + car.n_modes
+    q = jnp.zeros(n).at[2].set(0.01).at[6:12].set(1e-4).at[12:16].set(0.004)
+    u = jnp.zeros(n).at[0].set(25.0).at[3:6].set(0.1).at[6:12].set(0.02).at[12:16].set(0.05).at[16:].set(80.0)
+    aux = jnp.full(10, 1e-3)
+    rack, rack_rate = jnp.asarray(0.01), jnp.asarray(0.1)
+    g, km = model.geometry, model.kmap
+    travel, modes = q[12:16], q[6:12]
+
+    def kinematics(q, u, aux):
+        return fast.fast_dynamics(car, model, q, u, aux, 0.3, inputs, elements).kinematics
+
+    kin = jax.jit(kinematics)(q, u, aux)
+    suspensions = [e for e in elements if type(e).__name__ == "PushrodSuspension"]
+    four = fs.four_corner_suspension(suspensions)
+    yield "map guess", lambda tr: ck.map_guess(km, tr, jnp.broadcast_to(rack, (4,))), (travel,)
+    yield "corner poses", lambda tr, md: ck.corner_poses(g, km, tr, rack, md), (travel, modes)
+    yield "corner motion", lambda tr, md, ur: ck.corner_motion(g, km, tr, rack, md, ur[12:16], rack_rate,
+                                                               ur[6:12], 0.0), (travel, modes, u)
+    yield "car motion", lambda q, u: fast.car_motion(car, model, q, u, rack, rack_rate, 0.0), (q, u)
+    yield "kinematics", kinematics, (q, u, aux)
+    for k, e in enumerate(elements):
+        yield f"{type(e).__name__} [{k}]", lambda kin, aux, e=e: mb.element_forces(
+            car.system, model.params, (e,), kin, aux[: len(e.aux_names)]), (kin, aux)
+    yield "four-corner suspension", lambda kin: fs.suspension_forces(four, kin), (kin,)
+    yield "full", lambda q, u, aux: _outputs(fast.fast_dynamics(car, model, q, u, aux, 0.3, inputs, elements)), (
+        q, u, aux)
+
+
+def _outputs(d):
+    return d.q_dot, d.u_dot, d.aux_dot
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", type=Path, help="also write the table as JSON here")
+    parser.add_argument("--repeats", type=int, default=5, help="timed loops per piece (best taken)")
+    args = parser.parse_args()
+    rows = []
+    print(f"{'piece':28s} {'ops':>5s} {'us':>8s}  by kind")
+    for name, f, a in pieces():
+        ops = entry_ops(f, *a)
+        us = loop_time(f, *a, repeats=args.repeats) * 1e6
+        kinds = {k: v for k, v in ops.most_common() if k != "parameter"}
+        rows.append({"piece": name, "ops": sum(kinds.values()), "us": us, "by_kind": kinds})
+        print(f"{name:28s} {sum(kinds.values()):5d} {us:8.1f}  {dict(list(kinds.items())[:6])}", flush=True)
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()
