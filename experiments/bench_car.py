@@ -176,8 +176,15 @@ def bench(quick: bool, log) -> dict:
         res["grad_s"] = _best(grad, car.params, repeats=2)
         res["grad_over_forward"] = res["grad_s"] / res["forward_s"]
         res["grad_finite"] = bool(all(np.all(np.isfinite(x)) for x in jax.tree.leaves(g)))
+        # the reverse-mode gradient against a central difference, one leaf (front anti-roll bar)
+        h = 1e-3 * car.params.arb_rates[0]
+        shifted = [eqx.tree_at(lambda p: p.arb_rates, car.params, car.params.arb_rates.at[0].add(s * h))
+                   for s in (1.0, -1.0)]
+        res["d_overshoot_d_front_arb"] = float(g.arb_rates[0])
+        res["d_overshoot_d_front_arb_central_difference"] = float((forward(shifted[0]) - forward(shifted[1])) / (2 * h))
         log(f"gradient of the overshoot w.r.t. CarParams: {res['grad_s']:.2f} s = {res['grad_over_forward']:.1f} x "
-            f"forward ({res['forward_s']:.2f} s)")
+            f"forward ({res['forward_s']:.2f} s); d overshoot / d front ARB {res['d_overshoot_d_front_arb']:.4e} "
+            f"(central difference {res['d_overshoot_d_front_arb_central_difference']:.4e}) per N m/rad")
     else:
         res["grad_over_forward"] = None
 
