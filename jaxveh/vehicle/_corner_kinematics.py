@@ -25,7 +25,8 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..multibody import System, SystemParams, rotation_matrix
+from ..multibody import System, SystemParams
+from ..multibody._rotations import elementary
 from ._car import CORNERS
 from ._corner import QUARTER_CAR_LINKS
 
@@ -83,50 +84,85 @@ def corner_geometry(system: System, params: SystemParams, centres) -> CornerGeom
                           outer=jnp.stack(outer), lengths=jnp.stack(lengths), centre=centres)
 
 
+def _matmul(a, b):
+    """``a @ b`` for 3 x 3 matrices as elementwise sums (XLA fuses them; a dot per product
+    under ``vmap`` is one operation each)."""
+    return jnp.stack([jnp.stack([a[i, 0] * b[0, j] + a[i, 1] * b[1, j] + a[i, 2] * b[2, j] for j in range(3)])
+                      for i in range(3)])
+
+
+def rotation_zxy(angles: Float[Array, "3"]) -> Float[Array, "3 3"]:
+    """``rotation_matrix("zxy", angles)`` by elementwise products."""
+    return _matmul(_matmul(elementary(2, angles[0]), elementary(0, angles[1])), elementary(1, angles[2]))
+
+
 def relative_pose(w: Float[Array, "5"], travel, centre) -> tuple[Float[Array, "3"], Float[Array, "3 3"]]:
     """Upright origin (m) and rotation in the chassis frame from ``w`` and the travel (m)."""
     r = centre + jnp.stack([w[0], w[1], travel])
-    return r, rotation_matrix("zxy", w[2:])
+    return r, rotation_zxy(w[2:])
+
+
+def link_vectors(w, geometry: CornerGeometry, travel, rack, pivots) -> Float[Array, "5 3"]:
+    """Inner pivot minus outer point of each link (m, chassis axes). ``pivots``: the inner
+    pivots (5, 3) with the chassis deformation, before the rack."""
+    r, a = relative_pose(w, travel, geometry.centre)
+    p = geometry.outer
+    outer = jnp.stack([a[i, 0] * p[:, 0] + a[i, 1] * p[:, 1] + a[i, 2] * p[:, 2] + r[i] for i in range(3)], axis=1)
+    inner = pivots + (rack * geometry.rack)[:, None] * jnp.asarray([[0.0, 1.0, 0.0]])
+    return inner - outer
 
 
 def link_residual(w, geometry: CornerGeometry, travel, rack, pivots):
     """The five link equations of one corner, ``(|d|^2 - l^2) / (2 l)`` (m). ``pivots``:
     the inner pivots (5, 3) with the chassis deformation, before the rack."""
-    r, a = relative_pose(w, travel, geometry.centre)
-    inner = pivots + (rack * geometry.rack)[:, None] * jnp.asarray([[0.0, 1.0, 0.0]])
-    d = inner - (r[None, :] + geometry.outer @ a.T)
-    return (jnp.sum(d * d, axis=1) - geometry.lengths**2) / (2.0 * geometry.lengths)
+    d = link_vectors(w, geometry, travel, rack, pivots)
+    return (d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2 - geometry.lengths**2) / (2.0 * geometry.lengths)
 
 
-def solve_small(a, b):
-    """``a^-1 b`` for a small square ``a`` by Gaussian elimination with partial pivoting,
-    unrolled into elementwise operations (XLA fuses them; a LAPACK call per corner and
-    iteration cost more than the arithmetic). ``b``: a vector or a matrix of columns. The
-    row operations come from ``a`` alone, so the result is linear in ``b`` (and can be
-    transposed when ``b`` is a tangent)."""
-    n = a.shape[0]
-    vector = b.ndim == 1
-    b = b[:, None] if vector else b
-    rows = jnp.arange(n)
+#: Pivot rows of the elimination, fixed: the order partial pivoting picks for the library
+#: car's link Jacobian over the map's range (the alternative it picks at some states swaps
+#: the last two rows; the fixed order's pivots stay above 0.8 of partial pivoting's,
+#: condition numbers 40-120).
+PIVOT_ORDER = (2, 3, 4, 1, 0)
 
-    def swap(m, k, pivot):
-        row_k, row_p = m[k][None, :], m[pivot][None, :]
-        return jnp.where((rows == k)[:, None], row_p, jnp.where((rows == pivot)[:, None], row_k, m))
 
+def lu_small(a: Float[Array, "5 5"]) -> tuple[list, list, list]:
+    """Elimination of a link Jacobian in the fixed row order :data:`PIVOT_ORDER`, unrolled
+    into elementwise operations (XLA fuses them; a LAPACK call, or a pivot search, per
+    corner and solve cost more than the arithmetic): ``(rows of U, multipliers, 1 /
+    pivots)``."""
+    n = len(PIVOT_ORDER)
+    rows = [a[i] for i in PIVOT_ORDER]
+    multipliers, inverse = [], []
     for k in range(n):
-        pivot = jnp.argmax(jnp.where(rows >= k, jnp.abs(a[:, k]), -1.0))
-        a, b = swap(a, k, pivot), swap(b, k, pivot)
-        factors = jnp.where(rows > k, a[:, k] / a[k, k], 0.0)[:, None]
-        a = a - factors * a[k][None, :]
-        b = b - factors * b[k][None, :]
-    x = []
+        inverse.append(1.0 / rows[k][k])
+        factors = [rows[i][k] * inverse[k] for i in range(k + 1, n)]
+        rows[k + 1:] = [rows[i] - f * rows[k] for i, f in zip(range(k + 1, n), factors, strict=True)]
+        multipliers.append(factors)
+    return rows, multipliers, inverse
+
+
+def lu_solve_small(lu, b):
+    """``a^-1 b`` from :func:`lu_small`'s factors; ``b`` a vector or a matrix of columns
+    (linear in ``b``)."""
+    rows, multipliers, inverse = lu
+    n = len(rows)
+    b = [b[i] for i in PIVOT_ORDER]
+    for k in range(n):
+        b[k + 1:] = [b[i] - f * b[k] for i, f in zip(range(k + 1, n), multipliers[k], strict=True)]
+    x = [None] * n
     for k in reversed(range(n)):
         acc = b[k]
-        for j, xj in zip(range(k + 1, n), reversed(x), strict=True):
-            acc = acc - a[k, j] * xj
-        x.append(acc / a[k, k])
-    out = jnp.stack(x[::-1])
-    return out[:, 0] if vector else out
+        for j in range(k + 1, n):
+            acc = acc - rows[k][j] * x[j]
+        x[k] = acc * inverse[k]
+    return jnp.stack(x)
+
+
+def solve_small(a: Float[Array, "5 5"], b):
+    """``a^-1 b`` for a link Jacobian ``a`` (see :func:`lu_small`); ``b`` a vector or a
+    matrix of columns."""
+    return lu_solve_small(lu_small(a), b)
 
 
 def _newton(w, geometry, travel, rack, pivots, iterations: int):
@@ -181,11 +217,11 @@ def _fit_matrix(x, degree):
 
 
 def _chebyshev(x, degree):
-    """``[T_0(x), ..., T_degree(x)]`` by the three-term recurrence."""
-    out = [jnp.ones_like(x), x]
-    for _ in range(degree - 1):
-        out.append(2.0 * x * out[-1] - out[-2])
-    return jnp.stack(out[: degree + 1])
+    """``[T_0(x), ..., T_degree(x)]`` as ``cos(k arccos x)`` (one fused loop; the
+    three-term recurrence is a chain of separate operations). No derivative with respect to
+    ``x``: the guess only starts the solve, whose derivatives do not depend on it."""
+    angle = jnp.arccos(jax.lax.stop_gradient(x))
+    return jnp.cos(jnp.arange(degree + 1.0)[:, None] * angle[None, :])
 
 
 def _scaled(v, lo, hi):
