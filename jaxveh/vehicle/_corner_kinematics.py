@@ -26,7 +26,6 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from ..multibody import System, SystemParams
-from ..multibody._rotations import elementary
 from ._car import CORNERS
 from ._corner import QUARTER_CAR_LINKS
 
@@ -84,39 +83,72 @@ def corner_geometry(system: System, params: SystemParams, centres) -> CornerGeom
                           outer=jnp.stack(outer), lengths=jnp.stack(lengths), centre=centres)
 
 
-def _matmul(a, b):
-    """``a @ b`` for 3 x 3 matrices as elementwise sums (XLA fuses them; a dot per product
-    under ``vmap`` is one operation each)."""
-    return jnp.stack([jnp.stack([a[i, 0] * b[0, j] + a[i, 1] * b[1, j] + a[i, 2] * b[2, j] for j in range(3)])
-                      for i in range(3)])
+def _elementary(axis: int, c, s, o, z) -> list:
+    """Rows of the rotation about ``axis`` with cosine ``c``, sine ``s`` (``o``, ``z``: one
+    and zero; with ``(-s, c, z, z)`` its derivative with respect to the angle)."""
+    if axis == 0:
+        return [[o, z, z], [z, c, -s], [z, s, c]]
+    if axis == 1:
+        return [[c, z, s], [z, o, z], [-s, z, c]]
+    return [[c, -s, z], [s, c, z], [z, z, o]]
 
 
-def rotation_zxy(angles: Float[Array, "3"]) -> Float[Array, "3 3"]:
-    """``rotation_matrix("zxy", angles)`` by elementwise products."""
-    return _matmul(_matmul(elementary(2, angles[0]), elementary(0, angles[1])), elementary(1, angles[2]))
+def _matmul(a: list, b: list) -> list:
+    """``a @ b`` of 3 x 3 matrices held as rows of arrays (elementwise: XLA fuses it)."""
+    return [[a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j] for j in range(3)] for i in range(3)]
 
 
-def relative_pose(w: Float[Array, "5"], travel, centre) -> tuple[Float[Array, "3"], Float[Array, "3 3"]]:
-    """Upright origin (m) and rotation in the chassis frame from ``w`` and the travel (m)."""
-    r = centre + jnp.stack([w[0], w[1], travel])
-    return r, rotation_zxy(w[2:])
+def _rotation_zxy(angles, derivatives: bool = False) -> list:
+    """``rotation_matrix("zxy", angles)`` as rows of arrays; with ``derivatives`` also its
+    derivatives with respect to the three angles: ``[A, dA/d0, dA/d1, dA/d2]``."""
+    factors, slopes = [], []
+    for axis, angle in zip((2, 0, 1), angles, strict=True):
+        c, s = jnp.cos(angle), jnp.sin(angle)
+        o, z = jnp.ones_like(c), jnp.zeros_like(c)
+        factors.append(_elementary(axis, c, s, o, z))
+        slopes.append(_elementary(axis, -s, c, z, z))
+    out = [_matmul(_matmul(factors[0], factors[1]), factors[2])]
+    if derivatives:
+        for k in range(3):
+            f = [slopes[i] if i == k else factors[i] for i in range(3)]
+            out.append(_matmul(_matmul(f[0], f[1]), f[2]))
+    return out
 
 
-def link_vectors(w, geometry: CornerGeometry, travel, rack, pivots) -> Float[Array, "5 3"]:
-    """Inner pivot minus outer point of each link (m, chassis axes). ``pivots``: the inner
-    pivots (5, 3) with the chassis deformation, before the rack."""
-    r, a = relative_pose(w, travel, geometry.centre)
-    p = geometry.outer
-    outer = jnp.stack([a[i, 0] * p[:, 0] + a[i, 1] * p[:, 1] + a[i, 2] * p[:, 2] + r[i] for i in range(3)], axis=1)
-    inner = pivots + (rack * geometry.rack)[:, None] * jnp.asarray([[0.0, 1.0, 0.0]])
-    return inner - outer
+def _turn(a: list, p) -> list:
+    """Components of ``a @ p`` for the rows ``p`` (5, 3)."""
+    return [a[i][0] * p[:, 0] + a[i][1] * p[:, 1] + a[i][2] * p[:, 2] for i in range(3)]
+
+
+def _links(w, geometry: CornerGeometry, travel, rack, pivots, derivatives: bool = False):
+    """Components ``(d_x, d_y, d_z)`` (5,) each of inner pivot minus outer point (m, chassis
+    axes), and with ``derivatives`` the rotation's derivatives (see :func:`_rotation_zxy`)."""
+    rotations = _rotation_zxy([w[2], w[3], w[4]], derivatives)
+    outer = _turn(rotations[0], geometry.outer)
+    r = [geometry.centre[0] + w[0], geometry.centre[1] + w[1], geometry.centre[2] + travel]
+    shift = [0.0, rack * geometry.rack, 0.0]
+    d = [pivots[:, i] + shift[i] - r[i] - outer[i] for i in range(3)]
+    return d, rotations[1:]
 
 
 def link_residual(w, geometry: CornerGeometry, travel, rack, pivots):
     """The five link equations of one corner, ``(|d|^2 - l^2) / (2 l)`` (m). ``pivots``:
     the inner pivots (5, 3) with the chassis deformation, before the rack."""
-    d = link_vectors(w, geometry, travel, rack, pivots)
-    return (d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2 - geometry.lengths**2) / (2.0 * geometry.lengths)
+    (dx, dy, dz), _ = _links(w, geometry, travel, rack, pivots)
+    return (dx * dx + dy * dy + dz * dz - geometry.lengths**2) / (2.0 * geometry.lengths)
+
+
+def link_jacobians(w, geometry: CornerGeometry, travel, rack, pivots):
+    """``(residual, d residual / dw (5, 5), d/d travel (5,), d/d rack (5,), d/d pivots
+    (5, 3))`` of :func:`link_residual`, in closed form (``d residual / d d = d / l``)."""
+    d, slopes = _links(w, geometry, travel, rack, pivots, derivatives=True)
+    inv = 1.0 / geometry.lengths
+    residual = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - geometry.lengths**2) * (0.5 * inv)
+    unit = [di * inv for di in d]
+    turned = [_turn(a, geometry.outer) for a in slopes]
+    jac_w = jnp.stack([-unit[0], -unit[1]] + [-(unit[0] * t[0] + unit[1] * t[1] + unit[2] * t[2]) for t in turned],
+                      axis=1)
+    return residual, jac_w, -unit[2], geometry.rack * unit[1], jnp.stack(unit, axis=1)
 
 
 #: Pivot rows of the elimination, fixed: the order partial pivoting picks for the library
@@ -167,8 +199,7 @@ def solve_small(a: Float[Array, "5 5"], b):
 
 def _newton(w, geometry, travel, rack, pivots, iterations: int):
     def step(_, w):
-        res = link_residual(w, geometry, travel, rack, pivots)
-        jac = jax.jacfwd(link_residual)(w, geometry, travel, rack, pivots)
+        res, jac = link_jacobians(w, geometry, travel, rack, pivots)[:2]
         return w - solve_small(jac, res)
 
     return jax.lax.fori_loop(0, iterations, step, w, unroll=True)
@@ -186,7 +217,7 @@ def _solve_pose_jvp(primals, tangents):
     guess, geometry, travel, rack, pivots = primals
     _, d_geometry, d_travel, d_rack, d_pivots = tangents
     w = solve_pose(guess, geometry, travel, rack, pivots)
-    jac = jax.jacfwd(link_residual)(w, geometry, travel, rack, pivots)
+    jac = link_jacobians(w, geometry, travel, rack, pivots)[1]
     _, d_res = jax.jvp(lambda g, t, r, p: link_residual(w, g, t, r, p), (geometry, travel, rack, pivots),
                        (d_geometry, d_travel, d_rack, d_pivots))
     return w, -solve_small(jac, d_res)
@@ -303,8 +334,8 @@ def corner_motion(geometry: CornerGeometry, kmap: KinematicMap, travel, rack, mo
         def res(w, t, s, piv):
             return link_residual(w, g, t, s, piv)
 
-        jac_w, jac_t, jac_s, jac_piv = jax.jacfwd(res, argnums=(0, 1, 2, 3))(w, t, rack, piv)
-        jac_p = jnp.einsum("lpi,pim->lm", jac_piv, g.inner_shapes)
+        _, jac_w, jac_t, jac_s, jac_piv = link_jacobians(w, g, t, rack, piv)
+        jac_p = sum(jac_piv[:, i, None] * g.inner_shapes[:, i, :] for i in range(3))
         sens = -solve_small(jac_w, jnp.concatenate([jac_t[:, None], jac_s[:, None], jac_p], axis=1))
         w_dot = sens @ jnp.concatenate([jnp.stack([t_rate, rack_rate]), modal_rate])
 
