@@ -29,7 +29,7 @@ from jaxtyping import Array, Float
 
 from ..multibody import Kinematics, SystemParams, body_forces, element_forces, input_state, rotation_matrix
 from ..multibody._inputs import as_inputs
-from ..multibody._rotations import angular_velocity_matrix, elementary, skew
+from ..multibody._rotations import elementary, skew
 from ._car import CORNERS, Car, system_params, wheel_centres
 from ._corner_kinematics import (
     CornerGeometry,
@@ -122,10 +122,33 @@ class CarMotion(eqx.Module):
     velocity: object
 
 
+def _mv(a, v):
+    """``a @ v`` of 3 x 3 matrices and 3-vectors over leading axes, as elementwise sums (XLA
+    fuses them; a batched dot is one operation of its own)."""
+    return a[..., 0] * v[..., None, 0] + a[..., 1] * v[..., None, 1] + a[..., 2] * v[..., None, 2]
+
+
+def _mm(a, b):
+    """``a @ b`` of 3 x 3 matrices over leading axes, as elementwise sums."""
+    return a[..., :, 0, None] * b[..., None, 0, :] + a[..., :, 1, None] * b[..., None, 1, :] + (
+        a[..., :, 2, None] * b[..., None, 2, :])
+
+
+def _rotation_zxy(angles):
+    """``rotation_matrix("zxy", angles)`` by elementwise products."""
+    return _mm(_mm(elementary(2, angles[0]), elementary(0, angles[1])), elementary(1, angles[2]))
+
+
+def _rate_matrix_zxy(angles):
+    """``angular_velocity_matrix("zxy", angles)`` by elementwise products."""
+    r2t, r3t = elementary(0, angles[1]).T, elementary(1, angles[2]).T
+    return jnp.stack([_mv(r3t, r2t[:, 2]), r3t[:, 0], jnp.asarray([0.0, 1.0, 0.0])], axis=1)
+
+
 def _rel_pose(corners: CornerMotion, travel, centre):
     r = centre + jnp.concatenate([corners.w[:, :2], travel[:, None]], axis=1)
-    a = jax.vmap(lambda x: rotation_matrix("zxy", x))(corners.w[:, 2:])
-    e = jax.vmap(lambda x: angular_velocity_matrix("zxy", x))(corners.w[:, 2:])
+    a = jax.vmap(_rotation_zxy)(corners.w[:, 2:])
+    e = jax.vmap(_rate_matrix_zxy)(corners.w[:, 2:])
     return r, a, e
 
 
@@ -137,11 +160,11 @@ def _velocities(m, corners: CornerMotion, vc, travel_rate, spin_rate, rack_rate)
                           jnp.broadcast_to(vc[6:], (4, n_modes))], axis=1)
     w_dot = jnp.einsum("kwm,km->kw", corners.sens, xi)
     r_dot = jnp.concatenate([w_dot[:, :2], travel_rate[:, None]], axis=1)
-    omega_rel = jnp.einsum("kij,kj->ki", m.e_rel, w_dot[:, 2:])
+    omega_rel = _mv(m.e_rel, w_dot[:, 2:])
     u_c, w_c = vc[:3], vc[3:6]
     a_relt = jnp.swapaxes(m.a_rel, 1, 2)
-    v_up = jnp.einsum("kij,kj->ki", a_relt, u_c[None, :] + jnp.cross(w_c[None, :], m.r_rel) + r_dot)
-    w_up = jnp.einsum("kij,j->ki", a_relt, w_c) + omega_rel
+    v_up = _mv(a_relt, u_c[None, :] + jnp.cross(w_c[None, :], m.r_rel) + r_dot)
+    w_up = _mv(a_relt, w_c[None, :]) + omega_rel
     w_wheel = w_up + spin_rate[:, None] * jnp.asarray(_EY)
     return vc, v_up, w_up, w_wheel
 
@@ -166,16 +189,15 @@ def _bias(m: CarMotion, vc, travel_rate):
     c = m.corners
     r_dot = jnp.concatenate([c.w_dot[:, :2], travel_rate[:, None]], axis=1)
     r_acc = jnp.concatenate([c.w_acc0[:, :2], jnp.zeros((4, 1))], axis=1)
-    omega_rel = jnp.einsum("kij,kj->ki", m.e_rel, c.w_dot[:, 2:])
-    e_dot = jax.vmap(lambda a, da: jax.jvp(lambda x: angular_velocity_matrix("zxy", x), (a,), (da,))[1])(
+    omega_rel = _mv(m.e_rel, c.w_dot[:, 2:])
+    e_dot = jax.vmap(lambda a, da: jax.jvp(_rate_matrix_zxy, (a,), (da,))[1])(
         c.w[:, 2:], c.w_dot[:, 2:])
-    omega_rel_acc = jnp.einsum("kij,kj->ki", m.e_rel, c.w_acc0[:, 2:]) + jnp.einsum("kij,kj->ki", e_dot, c.w_dot[:, 2:])
+    omega_rel_acc = _mv(m.e_rel, c.w_acc0[:, 2:]) + _mv(e_dot, c.w_dot[:, 2:])
     u_c, w_c = vc[:3], vc[3:6]
     a_relt = jnp.swapaxes(m.a_rel, 1, 2)
     x = u_c[None, :] + jnp.cross(w_c[None, :], m.r_rel) + r_dot
-    v_acc = jnp.einsum("kij,kj->ki", a_relt, jnp.cross(w_c[None, :], r_dot) + r_acc) - jnp.cross(
-        omega_rel, jnp.einsum("kij,kj->ki", a_relt, x))
-    w_acc = -jnp.cross(omega_rel, jnp.einsum("kij,j->ki", a_relt, w_c)) + omega_rel_acc
+    v_acc = _mv(a_relt, jnp.cross(w_c[None, :], r_dot) + r_acc) - jnp.cross(omega_rel, _mv(a_relt, x))
+    w_acc = -jnp.cross(omega_rel, _mv(a_relt, w_c[None, :])) + omega_rel_acc
     return v_acc, w_acc
 
 
@@ -202,17 +224,17 @@ def _point_kinematics(car, model, lay, m: CarMotion, q, rack):
     local, shapes, rshapes, inputs, up, wh = _point_tables(car, model.params, lay)
     modes = qc[6:]
     x_ch = local + shapes @ modes + rack * inputs
-    a_up = jnp.einsum("ij,kjl->kil", m.a_c, m.a_rel)
-    r_up = m.r_c[None, :] + m.r_rel @ m.a_c.T
-    a_wh = jnp.einsum("kij,kjl->kil", a_up, m.spin_rot)
+    a_up = _mm(m.a_c[None], m.a_rel)
+    r_up = m.r_c[None, :] + _mv(m.a_c[None], m.r_rel)
+    a_wh = _mm(a_up, m.spin_rot)
     uc, wc = lay["upright_corner"], lay["wheel_corner"]
     x = jnp.concatenate([
-        m.r_c[None, :] + x_ch @ m.a_c.T,
-        r_up[uc] + jnp.einsum("kij,kj->ki", a_up[uc], up),
-        r_up[wc] + jnp.einsum("kij,kj->ki", a_wh[wc], wh),
+        m.r_c[None, :] + _mv(m.a_c[None], x_ch),
+        r_up[uc] + _mv(a_up[uc], up),
+        r_up[wc] + _mv(a_wh[wc], wh),
     ])[lay["unstack"]]
     theta = rshapes @ modes
-    rot_ch = m.a_c[None] + jnp.einsum("ij,kjl->kil", m.a_c, jax.vmap(skew)(theta))
+    rot_ch = m.a_c[None] + _mm(m.a_c[None], jax.vmap(skew)(theta))
     rots = jnp.concatenate([rot_ch, a_up[uc], a_wh[wc]])[lay["unstack"]]
     return x, rots, r_up, a_up, a_wh
 
@@ -225,14 +247,13 @@ def _point_rates(car, model, lay, m: CarMotion, velocity, a_up, q):
     vc, v_up, w_up, w_wheel = velocity
     x_ch = local + shapes @ qc[6:]
     uc, wc = lay["upright_corner"], lay["wheel_corner"]
-    xd_ch = (vc[None, :3] + jnp.cross(vc[None, 3:6], x_ch) + shapes @ vc[6:]) @ m.a_c.T
-    xd_up = jnp.einsum("kij,kj->ki", a_up[uc], v_up[uc] + jnp.cross(w_up[uc], up))
+    xd_ch = _mv(m.a_c[None], vc[None, :3] + jnp.cross(vc[None, 3:6], x_ch) + shapes @ vc[6:])
+    xd_up = _mv(a_up[uc], v_up[uc] + jnp.cross(w_up[uc], up))
     # wheel points (the hubs) sit on the spin axis: their velocity is the upright's there
-    xd_wh = jnp.einsum("kij,kj->ki", a_up[wc], v_up[wc] + jnp.cross(w_wheel[wc], jnp.einsum(
-        "kij,kj->ki", m.spin_rot[wc], wh)))
-    om_ch = (vc[None, 3:6] + rshapes @ vc[6:]) @ m.a_c.T
-    om_up = jnp.einsum("kij,kj->ki", a_up[uc], w_up[uc])
-    om_wh = jnp.einsum("kij,kj->ki", a_up[wc], w_wheel[wc])
+    xd_wh = _mv(a_up[wc], v_up[wc] + jnp.cross(w_wheel[wc], _mv(m.spin_rot[wc], wh)))
+    om_ch = _mv(m.a_c[None], vc[None, 3:6] + rshapes @ vc[6:])
+    om_up = _mv(a_up[uc], w_up[uc])
+    om_wh = _mv(a_up[wc], w_wheel[wc])
     xd = jnp.concatenate([xd_ch, xd_up, xd_wh])[lay["unstack"]]
     om = jnp.concatenate([om_ch, om_up, om_wh])[lay["unstack"]]
     return xd, om
@@ -334,10 +355,10 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     mass = jnp.stack([params.bodies[i].mass for i in lay["uprights"]])
     inertia = jnp.stack([params.bodies[i].inertia for i in lay["uprights"]])
     spin = jnp.stack([params.bodies[i].inertia[1, 1] for i in lay["wheels"]])
-    g_up = jnp.einsum("kji,j->ki", jnp.einsum("ij,kjl->kil", a_c, m.a_rel), params.gravity)
+    g_up = _mv(jnp.swapaxes(_mm(a_c[None], m.a_rel), 1, 2), params.gravity[None, :])
     # uprights: m (v_dot + w x v) = F, J w_dot + w x J w = T (c.g. at the wheel centre)
     f_up = mass[:, None] * (g_up - v_acc - jnp.cross(w_up, v_up))
-    t_up = -jnp.einsum("kij,kj->ki", inertia, w_acc) - jnp.cross(w_up, jnp.einsum("kij,kj->ki", inertia, w_up))
+    t_up = -_mv(inertia, w_acc) - jnp.cross(w_up, _mv(inertia, w_up))
     # wheels: rotors about the upright's y axis (angular velocity w_wheel in upright axes)
     h_wh = spin[:, None] * w_wheel * jnp.asarray(_EY)
     t_wh = -spin[:, None] * w_acc * jnp.asarray(_EY) - jnp.cross(w_wheel, h_wh)
