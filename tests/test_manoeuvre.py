@@ -91,6 +91,8 @@ def test_step_steer_fast_equals_library(runs, modes):
     fast, lib = _channels(runs[modes, "fast"]), _channels(runs[modes, "library"])
     assert set(fast) == set(UNITS)
     for name in fast:
+        if lib[name].size == 0:
+            continue  # the rigid car's modal coordinates
         scale = np.max(np.abs(lib[name]))
         assert np.max(np.abs(fast[name] - lib[name])) <= 1e-5 * scale, name
 
