@@ -36,6 +36,8 @@ def plot_manoeuvre(runs: dict, title: str = "", t_max: float | None = None):
         ax.grid(True, alpha=0.3)
         if ax.lines:
             ax.legend(fontsize=7, ncols=2 if which == "all" else 1)
+        else:
+            ax.text(0.5, 0.5, "rigid chassis: no modal coordinates", ha="center", va="center", transform=ax.transAxes)
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
