@@ -162,3 +162,15 @@ def test_experiment_figures(vehicle, experiments, tmp_path):
     _assert_clean(fig_3_9_root_locus.figure(vehicle, fig_3_9_root_locus.compute(vehicle, n=12)), tmp_path, "fig_3_9")
     _, panels = fig_3_11_preview.compute(vehicle, n_mu=3, extras=False)
     _assert_clean(fig_3_11_preview.figure(*panels), tmp_path, "fig_3_11")
+
+
+def test_manoeuvre_figure(tmp_path):
+    """The manoeuvre time histories, two runs overlaid (flexible with six modes, rigid)."""
+    from jaxveh.plots import plot_manoeuvre
+
+    t = np.linspace(0.0, 5.0, 101)
+    run = {k: 10.0 * np.tanh(t - 0.5) for k in ("steering_wheel_angle", "ay", "yaw_rate", "roll", "sideslip")}
+    runs = {"flexible, 6 modes": {"t_s": t, **run, "modes": 1e-3 * np.sin(np.outer(t, np.arange(1, 7)))},
+            "rigid": {"t_s": t, **run, "modes": np.zeros((101, 0))}}
+    _assert_clean(plot_manoeuvre(runs, title="step-steer at 90 km/h"), tmp_path, "manoeuvre")
+    _assert_clean(plot_manoeuvre({"rigid": runs["rigid"]}, title="rigid"), tmp_path, "manoeuvre_rigid")
