@@ -341,7 +341,10 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     def point_rates(uu):
         return _point_rates(car, model, lay, m, body_velocities(uu), a_up, q)
 
-    q_applied = jax.linear_transpose(point_rates, u)((forces, torques))[0]
+    # generalised forces by the point-velocity Jacobian (forward mode: gathers, where the
+    # transpose of the point-rate map scatters)
+    jac_x, jac_om = jax.jacfwd(point_rates)(u)
+    q_applied = jnp.einsum("pia,pi->a", jac_x, forces) + jnp.einsum("pia,pi->a", jac_om, torques)
     _, jac_v, jac_w, jac_wh = jax.jacfwd(body_velocities)(u)
     v_acc, w_acc = _bias(m, vc, travel_rate)
     chassis = params.bodies[0]
