@@ -42,9 +42,11 @@ def split_suspensions(elements) -> tuple[CornerSuspensions | None, tuple]:
     """``(suspensions, others)``: the push-rod suspensions among ``elements`` (those without
     auxiliary states) as one :class:`CornerSuspensions` and the other elements in their
     order; ``(None, elements)`` when there are none or their spring-damper tables differ in
-    size (they cannot share one axis)."""
+    size (they cannot share one axis) or two corners load one point (the forces are
+    gathered, not summed)."""
     picked = [e for e in elements if isinstance(e, PushrodSuspension) and not e.aux_names]
-    if not picked or len({_table_shapes(e) for e in picked}) > 1:
+    points = [k for e in picked for row in e.points for k in row]
+    if not picked or len({_table_shapes(e) for e in picked}) > 1 or len(set(points)) != len(points):
         return None, tuple(elements)
     return four_corner_suspension(picked), tuple(e for e in elements if not any(e is p for p in picked))
 
