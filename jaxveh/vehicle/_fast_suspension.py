@@ -4,8 +4,7 @@ The same forces as the library's :class:`~._suspension.PushrodSuspension` elemen
 chain of :mod:`._pushrod` per corner: wishbone point D, rocker angle in closed form, spring
 length and their rates, the spring-damper law, the anti-roll bar, the rocker balance and
 the wishbone's load sharing), with the corners of every element on one vectorised axis
-instead of one computation per axle, the spring and damper tables read without
-``jnp.interp``'s search loop, and the forces gathered onto the points instead of
+instead of one computation per axle, and the forces gathered onto the points instead of
 scattered.
 """
 
@@ -74,34 +73,13 @@ def four_corner_suspension(elements) -> CornerSuspensions:
     )
 
 
-# ---- spring-damper laws --------------------------------------------------------------------
-
-
-def _interpolate(x, xs, ys):
-    """:func:`._springs.interpolate` (piecewise linear, end slopes outside) with the interval
-    found by comparing against every knot (one fused loop; ``jnp.interp``'s search is a
-    while loop)."""
-    n = xs.shape[0]
-    i = jnp.clip(jnp.sum(x >= xs), 1, n - 1)
-    inside = ys[i - 1] + (x - xs[i - 1]) / (xs[i] - xs[i - 1]) * (ys[i] - ys[i - 1])
-    low = ys[0] + (x - xs[0]) * (ys[1] - ys[0]) / (xs[1] - xs[0])
-    high = ys[-1] + (x - xs[-1]) * (ys[-1] - ys[-2]) / (xs[-1] - xs[-2])
-    return jnp.where(x < xs[0], low, jnp.where(x > xs[-1], high, inside))
-
-
-def _law(law: SpringDamperLaw, length, rate):
-    """``law(length, rate)`` (N) of one corner."""
-    return (_interpolate(length, law.spring_length, law.spring_force)
-            + _interpolate(rate, law.damper_rate, law.damper_force) + law.bump_stop(length))
-
-
 def suspension_forces(s: CornerSuspensions, kin) -> Float[Array, "np 3"]:
     """Forces (N, global axes) of all the corners' push-rod paths on every point of
     ``kin`` (zero where none acts)."""
     idx = np.asarray(s.points, dtype=int)
     (lengths, thetas), (rates, _) = jax.vmap(corner_state)(kin.x[idx], kin.xd[idx], s.wishbone, s.mount)
     bar = -s.arb_rate * (thetas + thetas[np.asarray(s.partner)])
-    spring = jax.vmap(_law)(s.law, lengths, rates)
+    spring = jax.vmap(lambda law, length, rate: law(length, rate))(s.law, lengths, rates)
     forces = jax.vmap(corner_forces)(kin.x[idx], s.wishbone, s.mount, thetas, spring, bar).reshape(-1, 3)
     slot = np.full(kin.x.shape[0], forces.shape[0])
     slot[idx.reshape(-1)] = np.arange(forces.shape[0])
