@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from jaxveh._core import GRAVITY, ParameterError
 from jaxveh.cli import app
-from jaxveh.manoeuvre import UNITS, RampSteer, StepSteer, SweptSine, simulate, step_steer
+from jaxveh.manoeuvre import UNITS, RampSteer, StepSteer, SweptSine, simulate, step_steer, step_steer_metrics
 from jaxveh.vehicle import load_car
 
 ANGLE = np.deg2rad(6.0)
@@ -156,8 +156,9 @@ def test_cli_step_steer_json_and_files(runs, tmp_path):
                 "yaw_rate_overshoot_pct", "yaw_rate_steady_deg_s", "ay_steady_g"):
         assert np.isfinite(out[key]), key
     run = runs[0, "fast"]
-    np.testing.assert_allclose(out["yaw_rate_steady_deg_s"], np.mean(np.asarray(run.channels["yaw_rate"])[-51:]),
-                               rtol=1e-9)
+    api = step_steer_metrics(run.ts, run.channels, step_steer(angle=ANGLE).steering)
+    for key in ("yaw_rate_steady_deg_s", "ay_steady_g", "yaw_rate_response_time_s", "yaw_rate_overshoot_pct"):
+        np.testing.assert_allclose(out[key], api[key], rtol=1e-9, err_msg=key)
     assert 0.05 < out["yaw_rate_response_time_s"] < 0.5
     assert out["max_constraint_residual_m"] < 1e-9
     assert {p.name for p in tmp_path.iterdir()} == {"step_steer.json", "step_steer.csv", "step_steer.png"}
