@@ -25,9 +25,12 @@ QuietOpt = typer.Option(False, "--quiet", help="no progress messages on stderr")
 
 
 def _compilation_cache() -> None:
-    """Keep compiled programs between runs (the car's first compilation takes minutes)."""
+    """Keep compiled programs between runs (the car's first compilation takes minutes),
+    unless the caller already chose a cache folder."""
     import jax
 
+    if jax.config.jax_compilation_cache_dir:
+        return
     folder = Path(os.environ.get("JAXVEH_CACHE", Path.home() / ".cache" / "jaxveh" / "jax"))
     jax.config.update("jax_compilation_cache_dir", str(folder))
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
