@@ -43,12 +43,14 @@ def _say(quiet: bool, message: str) -> None:
 
 def _write(out_dir: Path, name: str, run, report: dict) -> None:
     from .. import plots
+    from ..manoeuvre import UNITS
 
     out_dir = Path(out_dir)
     write_json(report, out_dir / f"{name}.json")
     columns, header = [np.asarray(run.ts)], ["t_s"]
-    for key, values in run.channels.items():
-        v = np.asarray(values)
+    order = list(UNITS)  # the channels in their documented order (jit returns them sorted by name)
+    for key in sorted(run.channels, key=lambda k: order.index(k) if k in order else len(order)):
+        v = np.asarray(run.channels[key])
         unit = run.units[key]
         if v.ndim == 1:
             columns.append(v)
