@@ -154,8 +154,8 @@ def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, s
     in ``form`` ("fast" or "library"), from ``trim`` (default: straight running at the
     manoeuvre's speed): a pure function of the car and the manoeuvre (jit, vmap and grad
     through it; reverse mode uses Diffrax's recursive checkpointing)."""
-    trim = straight_running(car, manoeuvre.speed) if trim is None else trim
     run = _fast if check_form(form) == "fast" else _library
+    trim = straight_running(car, manoeuvre.speed) if trim is None else trim
     return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps)
 
 
