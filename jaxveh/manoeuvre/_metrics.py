@@ -3,21 +3,8 @@
 import numpy as np
 
 from .._core import ParameterError
+from ..analytic._transient import _first_crossing
 from ._driver import StepSteer
-
-
-def _first_crossing(ts, values, level) -> float:
-    """First time (s) ``values`` reaches ``level`` (linear interpolation; the sign of
-    ``level`` decides the direction)."""
-    s = np.sign(level) if level != 0 else 1.0
-    above = np.nonzero(s * values >= s * level)[0]
-    if above.size == 0:
-        return float("nan")
-    i = int(above[0])
-    if i == 0:
-        return float(ts[0])
-    v0, v1 = values[i - 1], values[i]
-    return float(ts[i - 1] + (level - v0) / (v1 - v0) * (ts[i] - ts[i - 1]))
 
 
 def step_steer_metrics(ts, channels: dict, steer: StepSteer, settle_window: float = 0.5) -> dict:
@@ -35,7 +22,7 @@ def step_steer_metrics(ts, channels: dict, steer: StepSteer, settle_window: floa
     t_half = float(steer.start) + 0.5 * float(steer.rise)
     peak = int(np.argmax(np.sign(r_ss) * r))
     return {
-        "yaw_rate_response_time_s": _first_crossing(ts, r, 0.9 * r_ss) - t_half,
+        "yaw_rate_response_time_s": _first_crossing(ts, np.sign(r_ss) * r, 0.9 * abs(r_ss)) - t_half,
         "yaw_rate_peak_time_s": float(ts[peak]) - t_half,
         "yaw_rate_overshoot_pct": 100.0 * (r[peak] - r_ss) / r_ss,
         "yaw_rate_steady_deg_s": r_ss,
