@@ -1,6 +1,7 @@
 """Manoeuvres on the chapter-6 car: open-loop steering laws with a held speed
 (:mod:`._driver`), integration from straight running in the fast or the library form with
-named channels (:mod:`._simulate`, :mod:`._channels`)."""
+named channels (:mod:`._simulate`, :mod:`._channels`); steady states (straight running,
+steady cornering, the skid-pad curve) of the fast car by root finding (:mod:`._steady`)."""
 
 from ._channels import UNITS as UNITS, car_channels as car_channels
 from ._driver import (
@@ -18,4 +19,12 @@ from ._simulate import (
     manoeuvre_channels as manoeuvre_channels,
     save_times as save_times,
     simulate as simulate,
+    straight_trim as straight_trim,
+)
+from ._steady import (
+    CONDITIONS as CONDITIONS,
+    SkidPad as SkidPad,
+    SteadyCornering as SteadyCornering,
+    skid_pad as skid_pad,
+    steady_state as steady_state,
 )

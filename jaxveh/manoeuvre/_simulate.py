@@ -1,8 +1,9 @@
 """Integrate the car through a manoeuvre from straight running, in either form, and return
 named channels (:mod:`._channels`) at the save times.
 
-The start is :func:`jaxveh.vehicle.straight_running` at the manoeuvre's speed (the
-library car's trim, mapped to the fast car's minimal coordinates); the rack follows the
+The start is straight running at the manoeuvre's speed, each form's own (the fast car's
+steady state by :mod:`._steady`, the library car's :func:`jaxveh.vehicle.straight_running`:
+the two agree to their Newton tolerances); the rack follows the
 steering law on top of the trim rack; the powertrain holds the speed. Both forms save on
 Diffrax's dense output (save times never force steps). :func:`manoeuvre_channels` is the
 pure, differentiable core; :func:`simulate` adds the checks, the wall time and the stop
@@ -28,13 +29,13 @@ from ..vehicle import (
     check_form,
     fast_dynamics,
     fast_model,
-    fast_state_from_library,
     steering_rack,
     straight_running,
     system_params,
 )
 from ._channels import UNITS, car_channels
 from ._driver import Manoeuvre
+from ._steady import compiled_core, condition_kinds, steady_state_core
 
 #: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; KenCarp4 IMEX with the
 #: chassis modes' linearised dynamics implicit; the fully implicit Kvaerno5.
@@ -83,9 +84,7 @@ def _rack_law(car, manoeuvre: Manoeuvre, trim_rack):
 
 def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
     law = _rack_law(car, manoeuvre, trim.rack)
-    params = system_params(car)
-    y0 = mb.joint_velocities(car.system, params, trim.static.q, trim.z, 0.0, law, 0.0, trim.aux)
-    s0 = fast_state_from_library(car, trim.static.q, y0, trim.aux)
+    s0 = trim.state
     model = fast_model(car)
     elements = car_elements(car, ConstantSpeed(manoeuvre.speed))
 
@@ -151,17 +150,35 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
 def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, solver: str = "tsit5", rtol=1e-4,
                        atol=1e-6, max_steps: int = 100_000):
     """``(channels, stats, result)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
-    in ``form`` ("fast" or "library"), from ``trim`` (default: straight running at the
-    manoeuvre's speed): a pure function of the car and the manoeuvre (jit, vmap and grad
-    through it; reverse mode uses Diffrax's recursive checkpointing)."""
+    in ``form`` ("fast" or "library"), from ``trim`` (default: :func:`straight_trim`): a
+    pure function of the car and the manoeuvre (jit, vmap and grad through it; reverse
+    mode uses Diffrax's recursive checkpointing)."""
     run = _fast if check_form(form) == "fast" else _library
-    trim = straight_running(car, manoeuvre.speed) if trim is None else trim
+    trim = straight_trim(car, manoeuvre.speed, form) if trim is None else trim
     return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps)
 
 
+def straight_trim(car, speed, form: str):
+    """Straight running at ``speed`` (m/s) in ``form``: the fast car's own steady state
+    (:func:`jaxveh.manoeuvre.steady_state` with zero yaw rate) or the library car's
+    :func:`jaxveh.vehicle.straight_running`; both have a ``rack``."""
+    if check_form(form) == "fast":
+        return steady_state_core(car, condition_kinds(("speed", "yaw_rate")), (speed, 0.0))[0]
+    return straight_running(car, speed)
+
+
 # the trim and the run compile separately (one large program compiles far slower than two)
-_compiled_trim = eqx.filter_jit(straight_running)
+_compiled_library_trim = eqx.filter_jit(straight_running)
 _compiled = eqx.filter_jit(manoeuvre_channels)
+
+
+def _compiled_trim(car, speed, form):
+    """:func:`straight_trim` compiled: the fast car's is the steady-state program every
+    :func:`jaxveh.manoeuvre.steady_state` call uses."""
+    speed = jnp.asarray(speed, jnp.float64)
+    if form == "fast":
+        return compiled_core(car, condition_kinds(("speed", "yaw_rate")), jnp.stack([speed, jnp.zeros_like(speed)]))[0]
+    return _compiled_library_trim(car, speed)
 
 
 def save_times(manoeuvre: Manoeuvre, points: int):
@@ -196,7 +213,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
         raise ParameterError(f"atol = {atol!r} is out of range: allowed > 0")
     ts = save_times(manoeuvre, points)
     start = time.perf_counter()
-    trim = _compiled_trim(car, manoeuvre.speed)
+    trim = _compiled_trim(car, manoeuvre.speed, form)
     # tolerances as arrays: one compilation serves every tolerance
     channels, stats, result = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
                                         rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
