@@ -8,11 +8,23 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import xarray
 from typer.testing import CliRunner
 
 from jaxveh._core import GRAVITY, ParameterError
 from jaxveh.cli import app
-from jaxveh.manoeuvre import UNITS, RampSteer, StepSteer, SweptSine, simulate, step_steer, step_steer_metrics
+from jaxveh.manoeuvre import (
+    UNITS,
+    CarRun,
+    RampSteer,
+    StepSteer,
+    SweptSine,
+    run_dataset,
+    simulate,
+    step_steer,
+    step_steer_metrics,
+    write_netcdf,
+)
 from jaxveh.vehicle import load_car
 
 ANGLE = np.deg2rad(6.0)
@@ -64,6 +76,22 @@ def test_bad_manoeuvres_are_refused(make, match):
 def test_bad_simulate_arguments_are_refused(kwargs, match):
     with pytest.raises(ParameterError, match=match):
         simulate(load_car(modes=0), step_steer(), **kwargs)
+
+
+def test_run_dataset_has_coordinates_and_units(tmp_path):
+    """A run as an xarray Dataset and a netCDF file: time, corner and mode coordinates, every
+    channel's unit, the values unchanged."""
+    ts = jnp.linspace(0.0, 1.0, 11)
+    channels = {"yaw_rate": jnp.sin(ts), "fz": jnp.outer(ts, jnp.arange(1.0, 5.0)), "modes": jnp.zeros((11, 3))}
+    run = CarRun(ts=ts, channels=channels, steps=jnp.asarray(7), rejected_steps=jnp.asarray(1),
+                 status=jnp.asarray(0), form="fast", stop_reason="completed", wall_s=0.1)
+    ds = run_dataset(run, {"manoeuvre": "test"})
+    assert ds["fz"].dims == ("time", "corner") and list(ds["corner"].values) == ["FL", "FR", "RL", "RR"]
+    assert ds["modes"].dims == ("time", "mode") and list(ds["mode"].values) == [1, 2, 3]
+    assert ds["yaw_rate"].attrs["units"] == "deg/s" and ds["time"].attrs["units"] == "s"
+    back = xarray.open_dataset(write_netcdf(run, tmp_path / "run.nc", {"manoeuvre": "test"}), engine="scipy")
+    np.testing.assert_array_equal(back["fz"].values, np.asarray(channels["fz"]))
+    assert back.attrs["manoeuvre"] == "test" and back.attrs["steps"] == 7 and back["fz"].attrs["units"] == "N"
 
 
 # ---- the step steer: fast car against library car ------------------------------------------------
@@ -161,7 +189,11 @@ def test_cli_step_steer_json_and_files(runs, tmp_path):
         np.testing.assert_allclose(out[key], api[key], rtol=1e-9, err_msg=key)
     assert 0.05 < out["yaw_rate_response_time_s"] < 0.5
     assert out["max_constraint_residual_m"] < 1e-9
-    assert {p.name for p in tmp_path.iterdir()} == {"step_steer.json", "step_steer.csv", "step_steer.png"}
+    assert {p.name for p in tmp_path.iterdir()} == {"step_steer.json", "step_steer.csv", "step_steer.nc",
+                                                    "step_steer.png"}
+    ds = xarray.open_dataset(tmp_path / "step_steer.nc", engine="scipy")
+    np.testing.assert_allclose(ds["yaw_rate"].values, np.asarray(run.channels["yaw_rate"]), rtol=1e-6, atol=1e-9)
+    assert ds["fz"].dims == ("time", "corner") and ds.attrs["manoeuvre"] == "step-steer"
     header = (tmp_path / "step_steer.csv").read_text().splitlines()[0].split(",")
     assert header[:3] == ["t_s", "steering_wheel_angle_deg", "speed_m/s"]
 

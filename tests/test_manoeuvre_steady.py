@@ -3,13 +3,17 @@ skid-pad curve (issue 12 item 3), checked against force balances, central differ
 the solves, and the end of a long time integration."""
 
 
+import json
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from jaxveh._core import GRAVITY, ParameterError
+from jaxveh.cli import app
 from jaxveh.manoeuvre import CONDITIONS, simulate, skid_pad, steady_state, step_steer, straight_trim
 from jaxveh.manoeuvre._steady import compiled_core, condition_kinds
 from jaxveh.multibody import rotation_matrix
@@ -122,6 +126,41 @@ def test_bad_skid_pad_arguments_are_refused(car):
         skid_pad(car, -5.0)
     with pytest.raises(ParameterError, match="ay must be a non-empty, increasing"):
         skid_pad(car, 50.0, [3.0, 2.0])
+
+
+def test_cli_skid_pad_json_and_files(car, pad, tmp_path):
+    """``jaxveh simulate skid-pad --json`` (R = 50 m, root finding): the understeer gradient
+    at the first point equals a central difference of two steady states; the curve, CSV and
+    PNG are written. Six points, as the fixture's curve: the compiled program is reused."""
+    result = CliRunner().invoke(app, ["simulate", "skid-pad", "--ay-max-g", "0.3", "--json", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.stdout)
+    assert report["radius_m"] == 50.0 and report["points"] == 6 and report["method"].startswith("steady states")
+    curve = report["curve"]
+    np.testing.assert_allclose(curve["ay_g"], np.arange(1, 7) * 0.05, rtol=1e-10)
+    h = 1e-2
+    delta = [np.mean(np.asarray(steady_state(car, radius=50.0, ay=0.05 * GRAVITY + s * h).channels[
+        "road_wheel_angle"])[:2]) for s in (1.0, -1.0)]
+    np.testing.assert_allclose(report["understeer_gradient_deg_per_g"], (delta[0] - delta[1]) / (2 * h) * GRAVITY,
+                               rtol=1e-4)
+    np.testing.assert_allclose(np.asarray(curve["delta_dynamic_deg"]) + report["kinematic_steer_deg"],
+                               curve["road_wheel_angle_deg"], rtol=1e-12)
+    np.testing.assert_allclose(report["kinematic_steer_deg"], np.degrees(float(car.params.vehicle.wheelbase) / 50.0))
+    assert report["max_residual"] < 1e-8 and not report["limit_reached"]
+    header = (tmp_path / "skid_pad.csv").read_text().splitlines()[0].split(",")
+    assert header[:3] == ["ay_g", "speed_kmh", "steering_wheel_angle_deg"] and "fz_rr_n" in header
+    assert (tmp_path / "skid_pad.png").stat().st_size > 10_000
+    assert json.loads((tmp_path / "skid_pad.json").read_text())["points"] == 6
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--form", "library"], "fast car only"),
+    (["--radius", "0"], "--radius must be > 0"),
+    (["--ay-step-g", "0"], "ay step = 0.0 g"),
+])
+def test_cli_skid_pad_refuses_bad_options(args, match):
+    result = CliRunner().invoke(app, ["simulate", "skid-pad", *args, "--json"])
+    assert result.exit_code == 2 and match in result.output
 
 
 def test_conditions_are_listed():

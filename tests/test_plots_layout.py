@@ -174,3 +174,14 @@ def test_manoeuvre_figure(tmp_path):
             "rigid": {"t_s": t, **run, "modes": np.zeros((101, 0))}}
     _assert_clean(plot_manoeuvre(runs, title="step-steer at 90 km/h"), tmp_path, "manoeuvre")
     _assert_clean(plot_manoeuvre({"rigid": runs["rigid"]}, title="rigid"), tmp_path, "manoeuvre_rigid")
+
+
+def test_skid_pad_figure(tmp_path):
+    """The skid-pad curves (Fig. 7.5), two overlaid."""
+    from jaxveh.plots import plot_skid_pad
+
+    ay = np.linspace(0.05, 1.2, 24)
+    curve = {"ay_g": ay, "delta_dynamic_deg": 0.7 * ay, "understeer_gradient_deg_per_g": 0.7 + ay,
+             "sideslip_deg": 0.5 - 3 * ay, "roll_deg": 2 * ay}
+    _assert_clean(plot_skid_pad({"rigid": curve, "flexible, 6 modes": curve}, title="skid-pad R = 50 m"), tmp_path,
+                  "skid_pad")

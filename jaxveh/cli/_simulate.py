@@ -20,7 +20,7 @@ FormOpt = typer.Option("fast", "--form", help="fast (minimal coordinates) or lib
 SpeedOpt = typer.Option(90.0, "--speed-kmh", help="speed held by the powertrain, km/h")
 RtolOpt = typer.Option(1e-4, "--rtol", help="relative tolerance of the step-size controller")
 JsonOpt = typer.Option(False, "--json", help="print only JSON on stdout")
-OutOpt = typer.Option(None, "--out", help="write JSON, CSV and a PNG into this folder")
+OutOpt = typer.Option(None, "--out", help="write JSON, CSV, netCDF (manoeuvres) and a PNG into this folder")
 QuietOpt = typer.Option(False, "--quiet", help="no progress messages on stderr")
 
 
@@ -43,7 +43,7 @@ def _say(quiet: bool, message: str) -> None:
 
 def _write(out_dir: Path, name: str, run, report: dict) -> None:
     from .. import plots
-    from ..manoeuvre import UNITS
+    from ..manoeuvre import UNITS, write_netcdf
 
     out_dir = Path(out_dir)
     write_json(report, out_dir / f"{name}.json")
@@ -62,6 +62,8 @@ def _write(out_dir: Path, name: str, run, report: dict) -> None:
                 header.append(f"{key}_{label}_{unit}")
     np.savetxt(out_dir / f"{name}.csv", np.column_stack(columns), delimiter=",", header=",".join(header),
                comments="")
+    attrs = {k: v for k, v in report.items() if isinstance(v, (str, int, float)) and not isinstance(v, bool)}
+    write_netcdf(run, out_dir / f"{name}.nc", attrs)
     history = {"t_s": np.asarray(run.ts)} | {k: np.asarray(v) for k, v in run.channels.items()}
     plots.save(plots.plot_manoeuvre({report["chassis"]: history}, title=report["title"]), out_dir / f"{name}.png")
 
@@ -171,3 +173,62 @@ def sine_sweep(
     except ParameterError as e:
         fail(str(e))
     _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet)
+
+
+@app.command("skid-pad")
+def skid_pad(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    radius: float = typer.Option(50.0, "--radius", help="circle radius, m (Fig. 7.5: 50)"),
+    ay_max_g: float = typer.Option(2.5, "--ay-max-g", help="highest lateral acceleration tried, g"),
+    step_g: float = typer.Option(0.05, "--ay-step-g", help="lateral acceleration step, g (also the first point)"),
+    out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+) -> None:
+    """Skid-pad (Fig. 7.5): the car's steady states on a circle by root finding, from
+    --ay-step-g to the grip limit; understeer gradient (deg/g, at the first point), dynamic
+    steer angle, steering sensitivity, sideslip and roll against ay."""
+    from .. import plots
+    from ..manoeuvre import skid_pad_report
+    from ..vehicle import load_car
+
+    _compilation_cache()
+    modes = 0 if rigid else modes
+    if form != "fast":
+        fail(f"--form {form!r}: the skid-pad's steady states are found on the fast car only (allowed: fast)")
+    if not radius > 0.0:
+        fail(f"--radius must be > 0 m, got {radius:g}")
+    try:
+        car = load_car(vehicle, modes=modes, form=form)
+        _say(quiet, f"jaxveh: skid-pad R = {radius:g} m, {modes} chassis modes (the first run compiles for minutes)")
+        report = skid_pad_report(car, radius, ay_max_g, step_g)
+    except (ParameterError, RuntimeError) as e:
+        fail(str(e))
+    chassis = "rigid" if modes == 0 else f"flexible, {modes} modes"
+    report = {"manoeuvre": "skid-pad", "method": "steady states by root finding", "form": form, "modes": modes,
+              "chassis": chassis} | report
+    report["title"] = f"skid-pad R = {radius:g} m, {chassis}"
+    if out_dir is not None:
+        out_dir = Path(out_dir)
+        write_json(report, out_dir / "skid_pad.json")
+        curve = report["curve"]
+        header, columns = [], []
+        for key, values in curve.items():
+            v = np.asarray(values)
+            if v.ndim == 1:
+                header.append(key)
+                columns.append(v)
+            else:
+                labels = ("fl", "fr", "rl", "rr") if key == "fz_n" else range(1, v.shape[1] + 1)
+                for k, label in enumerate(labels):
+                    header.append(key.replace("_n", f"_{label}_n") if key == "fz_n" else f"{key}_{label}")
+                    columns.append(v[:, k])
+        np.savetxt(out_dir / "skid_pad.csv", np.column_stack(columns), delimiter=",", header=",".join(header),
+                   comments="")
+        plots.save(plots.plot_skid_pad({chassis: curve}, title=report["title"]), out_dir / "skid_pad.png")
+    if as_json:
+        emit_json(report)
+        return
+    typer.echo(f"{report['title']}: {report['points']} steady states up to {report['ay_limit_g']:.2f} g in "
+               f"{report['wall_time_s']:.2f} s (compilation included on a first run)"
+               + (f"; wrote {out_dir}" if out_dir else ""))
+    typer.echo(f"  understeer gradient at {report['understeer_gradient_at_g']:.2f} g = "
+               f"{report['understeer_gradient_deg_per_g']:.4g} deg/g")

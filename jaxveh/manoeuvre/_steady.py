@@ -296,11 +296,11 @@ _compiled_skid_pad = eqx.filter_jit(skid_pad_core)
 def skid_pad(car, radius=50.0, ay=None, max_steps: int = 64) -> SkidPad:
     """The skid-pad curve on a circle of ``radius`` m (default 50, the thesis's) turning left:
     steady states at the lateral accelerations ``ay`` (m/s^2, increasing, > 0; default 0.05 g
-    to 1.5 g in steps of 0.05 g) as one compiled call. Points beyond the car's limit come
-    back with ``ok`` False."""
+    to 2.5 g in steps of 0.05 g) as one compiled call (one compilation per car structure and
+    number of points). Points beyond the car's limit come back with ``ok`` False."""
     if not float(radius) > 0.0:
         raise ParameterError(f"radius = {radius!r} is out of range: allowed > 0 (m)")
-    ay = np.arange(1, 31) * 0.05 * GRAVITY if ay is None else np.asarray(ay, float)
+    ay = np.arange(1, 51) * 0.05 * GRAVITY if ay is None else np.asarray(ay, float)
     if ay.ndim != 1 or ay.size < 1 or not np.all(ay > 0.0) or not np.all(np.diff(ay) > 0.0):
         raise ParameterError("ay must be a non-empty, increasing sequence of positive lateral accelerations (m/s^2)")
-    return _compiled_skid_pad(car, radius, jnp.asarray(ay), max_steps=max_steps)
+    return _compiled_skid_pad(car, jnp.asarray(float(radius)), jnp.asarray(ay), max_steps=max_steps)

@@ -41,3 +41,31 @@ def plot_manoeuvre(runs: dict, title: str = "", t_max: float | None = None):
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+#: Skid-pad panels (Fig. 7.5): curve key, axis label.
+_SKID_PAD_PANELS = (
+    ("delta_dynamic_deg", "δd [deg]"),
+    ("understeer_gradient_deg_per_g", "ku [deg/g]"),
+    ("sideslip_deg", "β [deg]"),
+    ("roll_deg", "ϕ [deg]"),
+)
+
+
+def plot_skid_pad(curves: dict, title: str = ""):
+    """Dynamic steer angle, understeer gradient (Fig. 7.5b plots its inverse, which diverges
+    where a car passes through neutral steer), sideslip and roll against ay (Fig. 7.5) of
+    one or more skid-pad curves (``{label: curve}``, the ``curve`` of
+    :func:`jaxveh.manoeuvre.skid_pad_report`)."""
+    fig, axes = figure(2, 2, figsize=(10, 7))
+    styles = ("-", "--", "-.", ":")
+    for ax, (key, ylabel) in zip(axes.flat, _SKID_PAD_PANELS):
+        for (label, curve), style in zip(curves.items(), styles):
+            ax.plot(curve["ay_g"], curve[key], style, marker=".", label=label)
+        ax.set_xlabel("ay [g]")
+        ax.set_ylabel(ylabel)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
