@@ -198,6 +198,20 @@ def test_cli_step_steer_json_and_files(runs, tmp_path):
     assert header[:3] == ["t_s", "steering_wheel_angle_deg", "speed_m/s"]
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("form", ["fast", "library"])
+def test_a_spinning_car_stops_with_the_event_named(runs, form):
+    """126 km/h and 1.5 rad at the steering wheel: the rigid car spins; the run stops with the
+    event and its time named, the channels hold their last values (no inf, no NaN). The
+    compiled programs of the fixture's rigid runs serve (speed and steer are traced)."""
+    run = simulate(load_car(modes=0), step_steer(speed=35.0, angle=1.5), form=form, rtol=TIGHT, throw=False)
+    assert int(run.status) == 1 and run.stop_reason.startswith("spin after t = ")
+    valid = np.asarray(run.valid)
+    assert 0 < valid.sum() < valid.size and not valid[-1]
+    assert all(np.all(np.isfinite(np.asarray(v))) for v in run.channels.values())
+    assert abs(float(np.asarray(run.channels["sideslip"])[valid][-1])) > 30.0
+
+
 # ---- one parameter pytree: the same sensitivities in both forms ---------------------------------
 
 KNOBS = {

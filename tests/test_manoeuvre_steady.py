@@ -170,11 +170,12 @@ def test_conditions_are_listed():
 
 @pytest.mark.slow
 def test_steady_state_is_where_a_long_run_settles(car):
-    """Hold speed and steering (a step steer) for 25 s: every channel at the end equals the
+    """Hold speed and steering (a step steer) for 18 s: every channel at the end equals the
     steady state at that speed and steering-wheel angle to 1e-6 of the channel's range over
-    the run."""
+    the run (the slowest transient, the speed loop's, decays with about 0.9 s: after 12 s
+    the gap is still 2e-5)."""
     speed, angle = 25.0, np.radians(6.0)
-    run = simulate(car, step_steer(speed=speed, angle=angle, duration=25.0), rtol=1e-10, points=101)
+    run = simulate(car, step_steer(speed=speed, angle=angle, duration=18.0), rtol=1e-9, points=101)
     trim = straight_trim(car, speed, "fast")
     steer = float(-trim.rack / car.params.rack_ratio) + angle
     ss = steady_state(car, speed=speed, steer=steer)

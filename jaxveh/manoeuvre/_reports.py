@@ -24,7 +24,10 @@ def skid_pad_report(car, radius: float = 50.0, ay_max_g: float = 2.5, step_g: fl
     the implicit function theorem) at the first point, the linear range's value. Per point:
     ay (horizontal, at the c.g.), speed, steering-wheel and road-wheel angle, dynamic steer
     angle ``delta - l / R``, understeer gradient, steering sensitivity ``1 / ku``, sideslip,
-    roll, yaw rate, twist, modal coordinates and tyre loads."""
+    roll, yaw rate, twist, the front axle's share of the lateral load transfer (chi: right
+    less left tyre load, front over front plus rear; it includes the small static
+    differences the tyres' asymmetric offsets leave at ay = 0), modal coordinates and tyre
+    loads."""
     ay = skid_pad_grid(ay_max_g, step_g)
     start = time.perf_counter()
     pad = skid_pad(car, radius, ay)
@@ -35,6 +38,8 @@ def skid_pad_report(car, radius: float = 50.0, ay_max_g: float = 2.5, step_g: fl
     ch = {k: np.asarray(v)[ok] for k, v in pad.states.channels.items()}
     ku = np.asarray(pad.understeer_gradient)[ok]
     delta = ch["road_wheel_angle"][:, :2].mean(axis=1)
+    fz = ch["fz"]
+    transfer_front, transfer_rear = fz[:, 1] - fz[:, 0], fz[:, 3] - fz[:, 2]
     kinematic = np.degrees(float(car.params.vehicle.wheelbase) / radius)
     curve = {
         "ay_g": np.asarray(pad.states.ay)[ok] / GRAVITY,
@@ -48,6 +53,7 @@ def skid_pad_report(car, radius: float = 50.0, ay_max_g: float = 2.5, step_g: fl
         "roll_deg": ch["roll"],
         "yaw_rate_deg_s": ch["yaw_rate"],
         "twist_deg": ch["twist"],
+        "lltd_front_share": transfer_front / (transfer_front + transfer_rear),
         "modes": ch["modes"],
         "fz_n": ch["fz"],
     }

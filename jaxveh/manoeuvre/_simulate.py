@@ -33,6 +33,7 @@ from ..vehicle import (
     straight_running,
     system_params,
 )
+from ..vehicle._setup import CHASSIS_FORWARD, CHASSIS_LATERAL
 from ._channels import UNITS, car_channels
 from ._driver import Manoeuvre
 from ._steady import compiled_core, condition_kinds, steady_state_core
@@ -43,14 +44,20 @@ SOLVERS = ("tsit5", "kencarp4", "kvaerno5")
 #: First step (s): given rather than estimated, which would compile two more copies of the
 #: vector field; the controller adapts it from the first step on.
 FIRST_STEP = 1e-3
+#: Events that stop a run, by code (0: none): the chassis rolls or pitches beyond
+#: ``ROLLOVER_ANGLE``, or its velocity turns beyond ``SPIN_ANGLE`` from its x axis.
+EVENTS = ("rollover", "spin")
+ROLLOVER_ANGLE, SPIN_ANGLE = 1.0, 1.2  # rad (57 deg, 69 deg)
 
 
 class CarRun(eqx.Module):
     """A manoeuvre's result: save times ``ts`` (s), ``channels`` (name -> array with a
     leading time axis, units in ``units``), the ``form`` that ran, the Diffrax step counts,
-    ``status`` (0 completed, 2 solver failure), ``stop_reason`` ("completed", the failure
-    and its time, or "traced" under ``jit``) and ``wall_s`` (s, after compilation when the
-    caller compiled first; NaN under ``jit``)."""
+    ``status`` (0 completed, 1 stopped by an event, 2 solver failure), ``stop_reason``
+    ("completed", the event or the failure and its time, or "traced" under ``jit``),
+    ``wall_s`` (s, after compilation when the caller compiled first; NaN under ``jit``) and
+    ``valid`` (per save time: reached before the stop; later values hold the last reached
+    one, never inf or NaN)."""
 
     ts: Float[Array, " nt"]
     channels: dict
@@ -60,6 +67,7 @@ class CarRun(eqx.Module):
     form: str = eqx.field(static=True)
     stop_reason: str = eqx.field(static=True, default="traced")
     wall_s: float = eqx.field(static=True, default=float("nan"))
+    valid: Array | None = None
 
     @property
     def units(self) -> dict:
@@ -98,11 +106,30 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
         return out | {"constraint_residual": d.link_residual}
 
     terms = _imex_terms(field, s0, car.n_modes) if solver == "kencarp4" else diffrax.ODETerm(field)
+    conditions = tuple(lambda t, s, args, fn=fn, **kw: fn(s.q, s.u) for fn in (_rolled_over, _spun))
     sol = diffrax.diffeqsolve(
         terms, _solver(solver), 0.0, manoeuvre.duration, FIRST_STEP, s0,
-        saveat=diffrax.SaveAt(ts=ts, fn=save),
+        saveat=diffrax.SaveAt(ts=ts, fn=save), event=diffrax.Event(conditions),
         stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol), max_steps=max_steps, throw=False)
-    return sol.ys, sol.stats, sol.result
+    rolled, spun = sol.event_mask
+    status = jnp.where(sol.result == diffrax.RESULTS.successful, 0,
+                       jnp.where(sol.result == diffrax.RESULTS.event_occurred, 1, 2))
+    valid = jnp.isfinite(sol.ys["yaw_rate"])  # Diffrax fills the save times after a stop with inf
+    return sol.ys, dict(sol.stats) | {"event": _event_code(rolled, spun), "valid": valid}, status
+
+
+def _rolled_over(q, u):
+    """Roll or pitch beyond :data:`ROLLOVER_ANGLE` (chassis coordinates: yaw, pitch, roll)."""
+    return jnp.max(jnp.abs(q[4:6])) > ROLLOVER_ANGLE
+
+
+def _spun(q, u):
+    """The chassis velocity (body axes ``u[:2]``) beyond :data:`SPIN_ANGLE` from its x axis."""
+    return jnp.abs(jnp.arctan2(u[1], u[0])) > SPIN_ANGLE
+
+
+def _event_code(rolled, spun):
+    return jnp.where(rolled, 1, jnp.where(spun, 2, 0))
 
 
 def _imex_terms(field, s0: FastState, n_modes: int):
@@ -140,19 +167,31 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
                            manoeuvre.steering(t))
         return out | {"constraint_residual": jnp.max(jnp.abs(dyn.projection.phi))}
 
+    q_c = car.system.q_offsets[c]  # the chassis's x, y, z, yaw, pitch, roll
+
+    def rolled(state):
+        return _rolled_over(state.q[q_c:q_c + 6], None)
+
+    def spun(state):  # the independent velocities hold the chassis's body-axis u, v
+        return _spun(None, state.z[np.asarray([CHASSIS_FORWARD, CHASSIS_LATERAL])])
+
     sim = mb.simulate(car.system, system_params(car), trim.static.q, trim.z, 0.0, manoeuvre.duration, ts,
                       inputs=law, elements=elements, aux0=trim.aux, outputs=outputs, solver=_solver(solver),
                       rtol=rtol, atol=atol, dt0=FIRST_STEP, max_steps=max_steps,
-                      implicit_modes=solver == "kencarp4", throw=False)
-    return sim.outputs, sim.stats, sim.status
+                      implicit_modes=solver == "kencarp4", throw=False,
+                      events={"rollover": lambda t, st: rolled(st), "spin": lambda t, st: spun(st)})
+    event = jnp.where(sim.status == 1, _event_code(rolled(sim.final), spun(sim.final)), 0)
+    return sim.outputs, dict(sim.stats) | {"event": event, "valid": sim.valid}, sim.status
 
 
 def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, solver: str = "tsit5", rtol=1e-4,
                        atol=1e-6, max_steps: int = 100_000):
-    """``(channels, stats, result)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
+    """``(channels, stats, status)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
     in ``form`` ("fast" or "library"), from ``trim`` (default: :func:`straight_trim`): a
     pure function of the car and the manoeuvre (jit, vmap and grad through it; reverse
-    mode uses Diffrax's recursive checkpointing)."""
+    mode uses Diffrax's recursive checkpointing). ``stats``: Diffrax's counts, ``event``
+    (0 or the 1-based index into :data:`EVENTS`) and ``valid`` (save times reached);
+    ``status``: 0 completed, 1 stopped by an event, 2 solver failure."""
     run = _fast if check_form(form) == "fast" else _library
     trim = straight_trim(car, manoeuvre.speed, form) if trim is None else trim
     return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps)
@@ -186,12 +225,11 @@ def save_times(manoeuvre: Manoeuvre, points: int):
     return jnp.linspace(0.0, manoeuvre.duration, points)
 
 
-def _result_ok(form, result) -> tuple[int, str]:
-    if form == "fast":
-        ok = bool(result == diffrax.RESULTS.successful)
-        return (0, "completed") if ok else (2, f"solver failure: {diffrax.RESULTS[result]}")
-    status = int(result)
-    return status, "completed" if status == 0 else "solver failure"
+def _hold_after_stop(x, valid):
+    """Values at save times after a stop replaced by the last reached one."""
+    x, valid = np.asarray(x), np.asarray(valid)
+    last = max(int(valid.sum()) - 1, 0)
+    return np.where(valid.reshape((-1,) + (1,) * (x.ndim - 1)), x, x[last])
 
 
 def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "tsit5",
@@ -200,8 +238,11 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     :class:`CarRun` with ``points`` save times. ``form``: "fast" or "library" (default: the
     car's own, ``car.form``). ``rtol``/``atol``: the PID step-size controller's tolerances
     (default ``atol = rtol / 100`` on every state: metres, radians, modal coordinates).
-    A failed solve raises ``RuntimeError`` naming the last time reached (``throw=False``:
-    the run is returned with ``status`` 2 and the unreached save times hold inf)."""
+    A run stops early when the car rolls over or spins (:data:`EVENTS`; ``status`` 1,
+    ``stop_reason`` names the event and its time). A failed solve raises ``RuntimeError``
+    naming the last time reached (``throw=False``: the run is returned with ``status`` 2).
+    After a stop the channels hold their last reached values (``valid`` marks the save
+    times reached)."""
     form = check_form(car.form if form is None else form)
     _solver(solver)
     if not (isinstance(points, int) and points >= 2):
@@ -215,16 +256,21 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     start = time.perf_counter()
     trim = _compiled_trim(car, manoeuvre.speed, form)
     # tolerances as arrays: one compilation serves every tolerance
-    channels, stats, result = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
+    channels, stats, status = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
                                         rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
                                         max_steps=max_steps)
     channels = jax.block_until_ready(channels)
     wall = time.perf_counter() - start
-    status, reason = _result_ok(form, result)
-    if status:
-        reached = np.asarray(ts)[np.isfinite(np.asarray(channels["yaw_rate"]))]
-        reason = f"{reason} after t = {reached[-1] if reached.size else 0.0:.4g} s"
+    status, valid = int(status), np.asarray(stats["valid"])
+    reached = np.asarray(ts)[valid]
+    after = f"after t = {reached[-1] if reached.size else 0.0:.4g} s"
+    reason = "completed"
+    if status == 1:
+        reason = f"{EVENTS[int(stats['event']) - 1]} {after}"
+    elif status == 2:
+        reason = f"solver failure {after}"
         if throw:
             raise RuntimeError(f"the {form} car's integration failed: {reason}")
+    channels = {k: _hold_after_stop(v, valid) for k, v in channels.items()} if not valid.all() else channels
     return CarRun(ts=ts, channels=channels, steps=stats["num_steps"], rejected_steps=stats["num_rejected_steps"],
-                  status=jnp.asarray(status), form=form, stop_reason=reason, wall_s=wall)
+                  status=jnp.asarray(status), form=form, stop_reason=reason, wall_s=wall, valid=jnp.asarray(valid))

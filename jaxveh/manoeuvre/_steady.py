@@ -271,9 +271,8 @@ def skid_pad_core(car, radius, ay, max_steps: int = 64) -> SkidPad:
     kinds = condition_kinds(("radius", "ay"))
     radius = jnp.asarray(radius, jnp.float64)
     ay = jnp.asarray(ay, jnp.float64)
-    first = jnp.stack([radius, ay[0]])
-    # the first point from the straight-ahead guess, the rest by continuation
-    x_first, ok_first = _solve(car, model, kinds, first, initial_guess(car, kinds, first), max_steps)
+    # the first point from the rough guess (no tangent yet), the rest by continuation
+    x_first = initial_guess(car, kinds, jnp.stack([radius, ay[0]]))
 
     def step(carry, target):
         x_prev, ay_prev, tangent, alive = carry
@@ -285,7 +284,7 @@ def skid_pad_core(car, radius, ay, max_steps: int = 64) -> SkidPad:
         carry = (jnp.where(ok, x, x_prev), jnp.where(ok, target, ay_prev), jnp.where(ok, dx, tangent), ok)
         return carry, (state, grads, ok)
 
-    start = (x_first, ay[0], jnp.zeros_like(x_first), ok_first)
+    start = (x_first, ay[0], jnp.zeros_like(x_first), jnp.asarray(True))
     _, (states, grads, ok) = jax.lax.scan(step, start, ay)
     return SkidPad(radius=radius, ay=ay, states=states, gradients=grads, ok=ok)
 

@@ -194,6 +194,8 @@ def static_equilibrium(car: Car, max_steps: int = 32, throw: bool = True) -> Sta
 #: Independent velocities of the straight-running trim: the wheel spins and the chassis's
 #: lateral velocity (unknown), its forward velocity (held); the yaw rate is held at zero.
 _SPINS, _FORWARD, _LATERAL = (1, 3, 5, 7), 8, 9
+#: Rows of the chassis's body-axis forward and lateral velocities among the independent ones.
+CHASSIS_FORWARD, CHASSIS_LATERAL = _FORWARD, _LATERAL
 #: Auxiliary-state row of the powertrain's error integral: its equation (speed error = 0)
 #: holds identically at the held speed; the forward force balance sets the integral instead.
 _INTEGRAL_ROW = 8
