@@ -59,7 +59,7 @@ def _best(fn, *args, repeats=3):
 
 
 def runner(form: str):
-    """Jitted ``(car, trim, angle, rtol) -> (channels, stats, result)``."""
+    """Jitted ``(car, trim, angle, rtol) -> (channels, stats, status)``."""
 
     def run(car, trim, angle, rtol):
         m = step_steer(speed=SPEED, angle=angle, start=START, rise=RISE, duration=DURATION)
@@ -129,7 +129,9 @@ def bench(quick: bool, log) -> dict:
     res["trim_s"] = _best(trim_fn, car, SPEED, "fast")
     fast = runner("fast")
     rtol = jnp.asarray(RTOL)
-    (ch, stats, result), first = _timed(fast, car, trim, ANGLE, rtol)
+    (ch, stats, status), first = _timed(fast, car, trim, ANGLE, rtol)
+    if int(status) != 0:
+        raise RuntimeError(f"the benchmark step steer did not complete (status {int(status)})")
     res["run_compile_s"] = first
     res["compile_s"] = res["trim_compile_s"] + first
     res["wall_s"] = _best(fast, car, trim, ANGLE, rtol)

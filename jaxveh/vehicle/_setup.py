@@ -192,8 +192,9 @@ def static_equilibrium(car: Car, max_steps: int = 32, throw: bool = True) -> Sta
 # ---- straight running at speed ------------------------------------------------------------
 
 #: Independent velocities of the straight-running trim: the wheel spins and the chassis's
-#: lateral velocity (unknown), its forward velocity (held); the yaw rate is held at zero.
-_SPINS, _FORWARD, _LATERAL = (1, 3, 5, 7), 8, 9
+#: body-axis lateral velocity (unknown), its forward velocity (held), its vertical velocity
+#: (whatever keeps the motion horizontal); the yaw rate is held at zero.
+_SPINS, _FORWARD, _LATERAL, _VERTICAL = (1, 3, 5, 7), 8, 9, 10
 #: Rows of the chassis's body-axis forward and lateral velocities among the independent ones.
 CHASSIS_FORWARD, CHASSIS_LATERAL = _FORWARD, _LATERAL
 #: Auxiliary-state row of the powertrain's error integral: its equation (speed error = 0)
@@ -228,6 +229,10 @@ def _steady_residual_fn(car: Car):
         nq, nz = free_q.size, free_z.size
         q = _guess(car).at[free_q].set(x[:nq])
         z = jnp.zeros((n,), x.dtype).at[free_z].set(x[nq:nq + nz]).at[_FORWARD].set(speed)
+        # the chassis moves horizontally: its body-axis vertical velocity cancels the
+        # forward and lateral ones' vertical share on the pitched and rolled chassis
+        a = rotation_matrix("zyx", q[3:6])
+        z = z.at[_VERTICAL].set(-(a[2, 0] * z[_FORWARD] + a[2, 1] * z[_LATERAL]) / a[2, 2])
         return q, z, x[nq + nz], x[nq + nz + 1:]
 
     def residual(x, args):
