@@ -93,6 +93,9 @@ def test_run_dataset_has_coordinates_and_units(tmp_path):
     back = xarray.open_dataset(write_netcdf(run, tmp_path / "run.nc", {"manoeuvre": "test"}), engine="scipy")
     np.testing.assert_array_equal(back["fz"].values, np.asarray(channels["fz"]))
     assert back.attrs["manoeuvre"] == "test" and back.attrs["steps"] == 7 and back["fz"].attrs["units"] == "N"
+    rigid = eqx.tree_at(lambda r: r.channels, run, channels | {"modes": jnp.zeros((11, 0))})
+    back = xarray.open_dataset(write_netcdf(rigid, tmp_path / "rigid.nc"), engine="scipy")
+    assert "modes" not in back and "mode" not in back.coords and back["fz"].shape == (11, 4)
 
 
 # ---- the step steer: fast car against library car ------------------------------------------------

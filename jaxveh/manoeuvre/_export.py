@@ -1,6 +1,7 @@
 """Export of a manoeuvre's channels as an xarray Dataset (netCDF): a ``time`` coordinate in
 seconds, per-corner channels on a ``corner`` axis (FL, FR, RL, RR), modal coordinates on a
-``mode`` axis (1 ... n), each variable's unit in its ``units`` attribute."""
+``mode`` axis (1 ... n; no modal variable for a rigid chassis), each variable's unit in
+its ``units`` attribute."""
 
 from pathlib import Path
 
@@ -21,6 +22,8 @@ def run_dataset(run, attrs: dict | None = None):
     data = {}
     for name, values in run.channels.items():
         v = np.asarray(values)
+        if v.size == 0:  # the rigid car's modal coordinates: netCDF 3 has no empty fixed axis
+            continue
         if v.ndim == 1:
             dims = ("time",)
         elif name == "modes":
@@ -28,8 +31,9 @@ def run_dataset(run, attrs: dict | None = None):
         else:
             dims = ("time", "corner")
         data[name] = (dims, v, {"units": run.units[name]})
-    coords = {"time": ("time", np.asarray(run.ts), {"units": "s"}), "corner": list(CORNER_LABELS),
-              "mode": np.arange(1, n_modes + 1)}
+    coords = {"time": ("time", np.asarray(run.ts), {"units": "s"}), "corner": list(CORNER_LABELS)}
+    if n_modes:
+        coords["mode"] = np.arange(1, n_modes + 1)
     meta = {"form": run.form, "stop_reason": run.stop_reason, "steps": int(run.steps),
             "rejected_steps": int(run.rejected_steps)} | (attrs or {})
     return xr.Dataset(data, coords=coords, attrs=meta)

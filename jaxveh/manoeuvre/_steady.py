@@ -35,6 +35,7 @@ from ..multibody import TimeInputs, rotation_matrix
 from ..vehicle import (
     ConstantSpeed,
     FastState,
+    SetupError,
     car_elements,
     fast_dynamics,
     fast_model,
@@ -83,8 +84,9 @@ def check_conditions(conditions: dict) -> tuple[str, str]:
     return tuple(n for n in CONDITIONS if n in names)
 
 
-def _sizes(car, elements):
-    return car.n_modes, sum(len(e.aux_names) for e in elements)
+def _n_aux(car) -> int:
+    """Number of the car's auxiliary states (tyres, powertrain)."""
+    return sum(len(e.aux_names) for e in car_elements(car))
 
 
 def _unpack(car, x, n_aux):
@@ -155,7 +157,7 @@ def initial_guess(car, kinds, values) -> Float[Array, " nx"]:
     v, t = car.params.vehicle, car.params.tyres
     sink = WHEEL_CENTRE_HEIGHT - jnp.mean(t.unloaded_radius - static_corner_loads(v) / t.vertical_stiffness)
     nm = car.n_modes
-    n_aux = _sizes(car, car_elements(car))[1]
+    n_aux = _n_aux(car)
     aux = jnp.zeros(n_aux).at[-1].set(speed)  # the powertrain's speed filter holds the speed
     rack = jnp.where(has("steer"), steering_rack(car, given("steer")), 0.0)
     zero = jnp.zeros_like(speed)
@@ -165,7 +167,7 @@ def initial_guess(car, kinds, values) -> Float[Array, " nx"]:
 
 
 def _solve(car, model, kinds, values, x0, max_steps):
-    n_aux = _sizes(car, car_elements(car))[1]
+    n_aux = _n_aux(car)
     args = (car, model, kinds, values, n_aux)
     solver = optx.Newton(rtol=STEADY_RTOL, atol=STEADY_ATOL)
     sol = optx.root_find(_residual, solver, x0, args, max_steps=max_steps, throw=False)
@@ -173,7 +175,7 @@ def _solve(car, model, kinds, values, x0, max_steps):
 
 
 def _result(car, model, kinds, values, x, converged) -> SteadyCornering:
-    n_aux = _sizes(car, car_elements(car))[1]
+    n_aux = _n_aux(car)
     d, ch, speed_h, (q, u, rack, aux, speed_target, omega) = _evaluate(car, model, x, n_aux)
     residual = jnp.max(jnp.abs(jnp.concatenate([d.u_dot, d.aux_dot,
                                                 _conditions(car, kinds, values, rack, speed_target, omega,
@@ -205,7 +207,7 @@ def _sensitivities(car, model, kinds, values, x):
     """``(dx, d channels)``: derivatives of the unknowns and of every channel with respect to
     the last condition's value at the steady state ``x`` (implicit function theorem:
     ``J dx = e``, ``e`` that condition's row)."""
-    n_aux = _sizes(car, car_elements(car))[1]
+    n_aux = _n_aux(car)
     args = (car, model, kinds, values, n_aux)
     jac = jax.jacfwd(_residual)(x, args)
     dx = jnp.linalg.solve(jac, jnp.zeros_like(x).at[-1].set(1.0))
@@ -221,8 +223,9 @@ def steady_state(car, *, speed=None, radius=None, ay=None, yaw_rate=None, steer=
     """The fast car's steady state for two of ``speed`` (m/s, the powertrain's set-point),
     ``radius`` (m), ``ay`` (m/s^2), ``yaw_rate`` (rad/s) and ``steer`` (steering-wheel angle,
     rad) (module docs): straight running is ``speed=V, yaw_rate=0``; a skid-pad point
-    ``radius=R, ay=a``; where an open-loop run settles ``speed=V, steer=d``. Positive radius, ay and
-    yaw rate turn left; a negative ``ay`` or ``yaw_rate`` turns right. Differentiable in the
+    ``radius=R, ay=a``; where an open-loop run settles ``speed=V, steer=d``. Positive ay, yaw
+    rate and steer turn left (``radius`` is a magnitude: with it, ay must be positive).
+    Differentiable in the
     car's parameters and the conditions (implicit function theorem). ``throw``: a failed
     solve raises :class:`jaxveh.vehicle.SetupError` naming the residual."""
     given = {k: v for k, v in (("speed", speed), ("radius", radius), ("ay", ay), ("yaw_rate", yaw_rate),
@@ -235,8 +238,6 @@ def steady_state(car, *, speed=None, radius=None, ay=None, yaw_rate=None, steer=
     values = jnp.asarray([float(given[n]) for n in names])  # an array: new values never recompile
     result, _ = compiled_core(car, condition_kinds(names), values, max_steps=max_steps)
     if throw and not bool(result.ok):
-        from ..vehicle import SetupError
-
         raise SetupError(f"no steady state at {', '.join(f'{n} = {float(given[n]):g}' for n in names)}: largest "
                          f"residual {float(result.residual):.3e} after {max_steps} Newton steps (beyond the tyres' "
                          "grip, or no equilibrium)")
