@@ -22,6 +22,7 @@ from jaxtyping import Array, Float
 
 from .. import multibody as mb
 from .._core import ParameterError
+from ..multibody._simulate import _hold_after_stop
 from ..vehicle import (
     ConstantSpeed,
     FastState,
@@ -225,13 +226,6 @@ def save_times(manoeuvre: Manoeuvre, points: int):
     return jnp.linspace(0.0, manoeuvre.duration, points)
 
 
-def _hold_after_stop(x, valid):
-    """Values at save times after a stop replaced by the last reached one."""
-    x, valid = np.asarray(x), np.asarray(valid)
-    last = max(int(valid.sum()) - 1, 0)
-    return np.where(valid.reshape((-1,) + (1,) * (x.ndim - 1)), x, x[last])
-
-
 def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "tsit5",
              rtol: float = 1e-4, atol: float | None = None, max_steps: int = 100_000, throw: bool = True) -> CarRun:
     """Run ``manoeuvre`` on ``car`` (compiled once per car structure and solver) and return a
@@ -271,6 +265,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
         reason = f"solver failure {after}"
         if throw:
             raise RuntimeError(f"the {form} car's integration failed: {reason}")
-    channels = {k: _hold_after_stop(v, valid) for k, v in channels.items()} if not valid.all() else channels
+    if not valid.all():  # the library car's rule for save times after a stop
+        channels = {k: _hold_after_stop(jnp.asarray(v), jnp.asarray(valid)) for k, v in channels.items()}
     return CarRun(ts=ts, channels=channels, steps=stats["num_steps"], rejected_steps=stats["num_rejected_steps"],
                   status=jnp.asarray(status), form=form, stop_reason=reason, wall_s=wall, valid=jnp.asarray(valid))
