@@ -6,6 +6,7 @@ solutions and modal reductions need double precision. Library entry points call
 :func:`check_x64`, which raises if a user switched it off afterwards.
 """
 
+import contextlib
 from importlib import resources
 from pathlib import Path
 
@@ -32,6 +33,31 @@ def check_x64() -> None:
             "jaxveh needs float64: jax_enable_x64 was switched off after importing "
             "jaxveh. Call jax.config.update('jax_enable_x64', True)."
         )
+
+
+@contextlib.contextmanager
+def run_time_checks_off():
+    """Trace with every run-time check (``eqx.error_if``: jaxveh's traced parameter checks,
+    Diffrax's and Optimistix's) compiled out.
+
+    For compiled programs whose inputs the caller has checked before the call and whose
+    failures it reads from returned flags. A run-time check puts a host callback into the
+    program, and JAX's persistent compilation cache does not store programs with host
+    callbacks: without them the car's programs (minutes to compile) compile once per
+    machine instead of once per process. Equinox reads its ``EQX_ON_ERROR`` setting when a
+    check is traced; this sets it to "off" meanwhile (no effect where Equinox lacks it).
+    """
+    import equinox._errors as errors
+
+    if not hasattr(errors, "EQX_ON_ERROR"):
+        yield
+        return
+    before = errors.EQX_ON_ERROR
+    errors.EQX_ON_ERROR = "off"
+    try:
+        yield
+    finally:
+        errors.EQX_ON_ERROR = before
 
 
 def as_float(x):

@@ -21,12 +21,14 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .. import multibody as mb
-from .._core import ParameterError
+from .._core import ParameterError, run_time_checks_off
 from ..multibody._simulate import _hold_after_stop
 from ..vehicle import (
     ConstantSpeed,
     FastState,
+    SetupError,
     car_elements,
+    check_car,
     check_form,
     fast_dynamics,
     fast_model,
@@ -213,12 +215,15 @@ _compiled = eqx.filter_jit(manoeuvre_channels)
 
 
 def _compiled_trim(car, speed, form):
-    """:func:`straight_trim` compiled: the fast car's is the steady-state program every
-    :func:`jaxveh.manoeuvre.steady_state` call uses."""
+    """``(trim, ok)``: :func:`straight_trim` compiled (the fast car's is the steady-state
+    program every :func:`jaxveh.manoeuvre.steady_state` call uses) and whether its Newton
+    solve converged."""
     speed = jnp.asarray(speed, jnp.float64)
     if form == "fast":
-        return compiled_core(car, condition_kinds(("speed", "yaw_rate")), jnp.stack([speed, jnp.zeros_like(speed)]))[0]
-    return _compiled_library_trim(car, speed)
+        trim = compiled_core(car, condition_kinds(("speed", "yaw_rate")), jnp.stack([speed, jnp.zeros_like(speed)]))[0]
+        return trim, trim.ok
+    trim = _compiled_library_trim(car, speed)
+    return trim, trim.static.ok
 
 
 def save_times(manoeuvre: Manoeuvre, points: int):
@@ -247,13 +252,18 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     if not atol > 0.0:
         raise ParameterError(f"atol = {atol!r} is out of range: allowed > 0")
     ts = save_times(manoeuvre, points)
+    check_car(car)  # here, so that the programs need no run-time checks (the disk cache keeps them)
     start = time.perf_counter()
-    trim = _compiled_trim(car, manoeuvre.speed, form)
-    # tolerances as arrays: one compilation serves every tolerance
-    channels, stats, status = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
-                                        rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
-                                        max_steps=max_steps)
-    channels = jax.block_until_ready(channels)
+    with run_time_checks_off():
+        trim, trim_ok = _compiled_trim(car, manoeuvre.speed, form)
+        if not bool(trim_ok):
+            raise SetupError(f"the {form} car's straight running at {float(manoeuvre.speed):g} m/s was not found "
+                             "(the powertrain's torque against drag and rolling resistance?)")
+        # tolerances as arrays: one compilation serves every tolerance
+        channels, stats, status = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
+                                            rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
+                                            max_steps=max_steps)
+        channels = jax.block_until_ready(channels)
     wall = time.perf_counter() - start
     status, valid = int(status), np.asarray(stats["valid"])
     reached = np.asarray(ts)[valid]

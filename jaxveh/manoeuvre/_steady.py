@@ -30,13 +30,14 @@ import numpy as np
 import optimistix as optx
 from jaxtyping import Array, Float
 
-from .._core import GRAVITY, ParameterError
+from .._core import GRAVITY, ParameterError, run_time_checks_off
 from ..multibody import TimeInputs, rotation_matrix
 from ..vehicle import (
     ConstantSpeed,
     FastState,
     SetupError,
     car_elements,
+    check_car,
     fast_dynamics,
     fast_model,
     static_corner_loads,
@@ -236,7 +237,8 @@ def steady_state(car, *, speed=None, radius=None, ay=None, yaw_rate=None, steer=
             raise ParameterError(f"{name} = {given[name]!r} is out of range: allowed > 0 "
                                  f"({'m/s' if name == 'speed' else 'm'})")
     values = jnp.asarray([float(given[n]) for n in names])  # an array: new values never recompile
-    result, _ = compiled_core(car, condition_kinds(names), values, max_steps=max_steps)
+    with run_time_checks_off():  # the car checked here: a program the disk cache keeps
+        result, _ = compiled_core(check_car(car), condition_kinds(names), values, max_steps=max_steps)
     if throw and not bool(result.ok):
         raise SetupError(f"no steady state at {', '.join(f'{n} = {float(given[n]):g}' for n in names)}: largest "
                          f"residual {float(result.residual):.3e} after {max_steps} Newton steps (beyond the tyres' "
@@ -303,4 +305,5 @@ def skid_pad(car, radius=50.0, ay=None, max_steps: int = 64) -> SkidPad:
     ay = np.arange(1, 51) * 0.05 * GRAVITY if ay is None else np.asarray(ay, float)
     if ay.ndim != 1 or ay.size < 1 or not np.all(ay > 0.0) or not np.all(np.diff(ay) > 0.0):
         raise ParameterError("ay must be a non-empty, increasing sequence of positive lateral accelerations (m/s^2)")
-    return _compiled_skid_pad(car, jnp.asarray(float(radius)), jnp.asarray(ay), max_steps=max_steps)
+    with run_time_checks_off():
+        return _compiled_skid_pad(check_car(car), jnp.asarray(float(radius)), jnp.asarray(ay), max_steps=max_steps)

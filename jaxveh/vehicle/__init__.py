@@ -34,6 +34,7 @@ from ._car import (
     static_corner_loads as static_corner_loads,
     steering as steering,
     steering_rack as steering_rack,
+    check_car as check_car,
     system_params as system_params,
     total_mass as total_mass,
     wheel_centres as wheel_centres,

@@ -37,7 +37,8 @@ from .. import fe
 from .._core import GRAVITY, ParameterError, as_float
 from ..multibody import FlexibleBody, RigidBody, System, SystemBuilder, SystemParams, TimeInputs
 from ..params import HARD_POINT_NAMES, CarFile, VehicleData, hard_points_vehicle_frame, read_car_file
-from ..tyre import fsae_tir_path, read_tir, stack_tyres
+from ..multibody._system import checked_params
+from ..tyre import check_tyre, fsae_tir_path, read_tir, stack_tyres
 from ._aero import AeroLoads, AeroMap, aero_map_from_coefficients
 from ._contact import AbstractRoad, FlatRoad, TyreContact
 from ._corner import QUARTER_CAR_LINKS, WHEEL_CENTRE_HEIGHT
@@ -220,6 +221,23 @@ def _build_system(vehicle: VehicleData, modal) -> tuple[System, SystemParams]:
                                                                                              modal.n_modes)):
         b.add_independent("chassis", name)
     return b.build()
+
+
+def check_car(car: Car) -> Car:
+    """Run every check the car's compiled programs would run on its parameters: the tyres'
+    coefficients, the chassis's modal stiffness multipliers and damping, and the library
+    parameters (masses, inertias, coupling, link lengths, points, gravity). Concrete
+    values raise :class:`~jaxveh.ParameterError` naming the value (traced ones fail at run
+    time); returns ``car``. Entry points that compile the car without run-time checks
+    (:func:`jaxveh._core.run_time_checks_off`) call this first, so a leaf set out of range
+    with ``eqx.tree_at`` is still refused by name."""
+    p = car.params
+    check_tyre(p.tyres)
+    if p.chassis is not None:
+        for check in (p.chassis._scale, p.chassis._alpha, p.chassis._beta, p.chassis._zeta):
+            check()
+    checked_params(car.system, system_params(car))
+    return car
 
 
 def system_params(car: Car) -> SystemParams:
