@@ -68,7 +68,10 @@ def _write(out_dir: Path, name: str, run, report: dict) -> None:
     plots.save(plots.plot_manoeuvre({report["chassis"]: history}, title=report["title"]), out_dir / f"{name}.png")
 
 
-def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics=None):
+def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics=None,
+         points: int = 501, figures=None):
+    """Simulate, report (plus ``metrics(run)``), write the files (plus ``figures(report)``:
+    name -> figure) and print."""
     from ..manoeuvre import simulate
     from ..vehicle import load_car
 
@@ -77,7 +80,7 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
     try:
         car = load_car(vehicle, modes=modes, form=form)
         _say(quiet, f"jaxveh: {name}, {modes} chassis modes, {form} form (the first run compiles for minutes)")
-        run = simulate(car, manoeuvre, rtol=rtol)
+        run = simulate(car, manoeuvre, rtol=rtol, points=points)
     except (ParameterError, RuntimeError) as e:
         fail(str(e))
     report = {
@@ -99,6 +102,11 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
     report["title"] = f"{name} at {report['speed_kmh']:g} km/h, {report['chassis']} ({form} form)"
     if out_dir is not None:
         _write(out_dir, name.replace("-", "_"), run, report)
+        if figures is not None:
+            from .. import plots
+
+            for suffix, fig in figures(report).items():
+                plots.save(fig, Path(out_dir) / f"{name.replace('-', '_')}_{suffix}.png")
     if as_json:
         emit_json(report)
         return
@@ -158,21 +166,36 @@ def ramp_steer(
 @app.command("sine-sweep")
 def sine_sweep(
     vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
-    speed_kmh: float = SpeedOpt,
+    speed_kmh: float = typer.Option(50.0, "--speed-kmh", help="speed held, km/h (Fig. 6.15: 50)"),
     steer_deg: float = typer.Option(5.0, "--steer-deg", help="steering-wheel amplitude, deg (Fig. 6.15: 5)"),
     f_max: float = typer.Option(15.0, "--f-max", help="end frequency, Hz (Fig. 6.15: 15)"),
-    duration: float = typer.Option(20.0, "--duration", help="sweep time, s"),
+    duration: float = typer.Option(120.0, "--duration", help="sweep time, s (Table 6.6: 120)"),
     rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
 ) -> None:
-    """Swept sine (Fig. 6.15): frequency rising linearly from 0 to --f-max over --duration."""
-    from ..manoeuvre import Manoeuvre, SweptSine
+    """Swept sine (Fig. 6.15): frequency rising linearly from 0 to --f-max over --duration;
+    yaw-rate and ay frequency responses per steering-wheel angle by FFT with a Gaussian
+    window (section 6.4.3), saved at 10 points per period of --f-max."""
+    from .. import plots
+    from ..manoeuvre import Manoeuvre, SweptSine, frequency_response
 
+    if not f_max > 0.0:
+        fail(f"--f-max must be > 0 Hz, got {f_max:g}")
     try:
         law = SweptSine(amplitude=math.radians(steer_deg), f0=0.0, f1=f_max, sweep=duration, start=0.0)
         m = Manoeuvre(steering=law, speed=_speed(speed_kmh), duration=duration)
     except ParameterError as e:
         fail(str(e))
-    _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet)
+
+    def metrics(run):
+        r = frequency_response(run.ts, run.channels, f_max=f_max)
+        return {"frequency_response": {k: np.asarray(v).tolist() for k, v in r.items()}}
+
+    def figures(report):
+        r = {k: np.asarray(v) for k, v in report["frequency_response"].items()}
+        return {"frf": plots.plot_frequency_response({report["chassis"]: r}, title=report["title"])}
+
+    points = max(501, math.ceil(10.0 * f_max * duration) + 1)
+    _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points, figures)
 
 
 @app.command("skid-pad")

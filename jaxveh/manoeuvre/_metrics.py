@@ -30,3 +30,43 @@ def step_steer_metrics(ts, channels: dict, steer: StepSteer, settle_window: floa
         "roll_steady_deg": float(np.asarray(channels["roll"])[tail].mean()),
         "sideslip_steady_deg": float(np.asarray(channels["sideslip"])[tail].mean()),
     }
+
+
+def frequency_response(ts, channels: dict, outputs=("yaw_rate", "ay"), f_max: float | None = None,
+                       window_sigma: float = 0.5) -> dict:
+    """Frequency responses of a swept-sine run by FFT (section 6.4.3, Fig. 6.15): each output
+    channel and the steering-wheel angle, less their values at the start (straight running),
+    times one Gaussian window centred on the record (standard deviation ``window_sigma`` of
+    the half record: the thesis's 0.5), give ``H(f) = Y(f) / U(f)`` at the FFT frequencies
+    ``k / T`` from the first non-zero one up to ``f_max`` (Hz; default the Nyquist frequency).
+
+    Returns ``frequency_hz`` and per output ``{name}_gain`` (channel units per degree of
+    steering-wheel angle: deg/s/deg for the yaw rate, g/deg for ay), ``{name}_gain_db``
+    (20 log10 of it) and ``{name}_phase_deg`` (unwrapped from the lowest frequency, so a
+    turn in the steered direction starts near 0). ``ts`` must be evenly spaced (s)."""
+    ts = np.asarray(ts, float)
+    dt = np.diff(ts)
+    if ts.size < 8 or not np.allclose(dt, dt[0], rtol=1e-9, atol=0.0):
+        raise ParameterError("ts must hold at least 8 evenly spaced save times for an FFT")
+    if not window_sigma > 0.0:
+        raise ParameterError(f"window_sigma = {window_sigma!r} is out of range: allowed > 0 (of the half record)")
+    nyquist = 0.5 / dt[0]
+    f_max = nyquist if f_max is None else float(f_max)
+    if not 0.0 < f_max <= nyquist * (1.0 + 1e-12):
+        raise ParameterError(f"f_max = {f_max!r} is out of range: allowed (0, {nyquist:g}] Hz (the Nyquist frequency)")
+    half = 0.5 * (ts[-1] - ts[0])
+    window = np.exp(-0.5 * ((ts - ts[0] - half) / (window_sigma * half)) ** 2)
+    u = np.asarray(channels["steering_wheel_angle"], float)
+    spectrum = np.fft.rfft(window * (u - u[0]))
+    freq = np.fft.rfftfreq(ts.size, dt[0])
+    keep = (freq > 0.0) & (freq <= f_max * (1.0 + 1e-12))
+    out = {"frequency_hz": freq[keep]}
+    for name in outputs:
+        y = np.asarray(channels[name], float)
+        if y.ndim != 1:
+            raise ParameterError(f"output {name!r} must be a scalar channel (one value per save time)")
+        h = (np.fft.rfft(window * (y - y[0])) / spectrum)[keep]
+        out[f"{name}_gain"] = np.abs(h)
+        out[f"{name}_gain_db"] = 20.0 * np.log10(np.abs(h))
+        out[f"{name}_phase_deg"] = np.rad2deg(np.unwrap(np.angle(h)))
+    return out

@@ -11,7 +11,11 @@ from ._chapter3 import (
     plot_step_steer as plot_step_steer,
     save as save,
 )
-from ._manoeuvres import plot_manoeuvre as plot_manoeuvre, plot_skid_pad as plot_skid_pad
+from ._manoeuvres import (
+    plot_frequency_response as plot_frequency_response,
+    plot_manoeuvre as plot_manoeuvre,
+    plot_skid_pad as plot_skid_pad,
+)
 from ._rigs import (
     plot_bump as plot_bump,
     plot_roll as plot_roll,

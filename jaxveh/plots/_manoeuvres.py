@@ -69,3 +69,25 @@ def plot_skid_pad(curves: dict, title: str = ""):
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+def plot_frequency_response(responses: dict, title: str = ""):
+    """Yaw-rate and lateral-acceleration frequency responses per steering-wheel angle,
+    magnitude (dB) and phase against frequency on a log axis (Fig. 6.15), of one or more
+    swept-sine runs (``{label: response}``, as :func:`jaxveh.manoeuvre.frequency_response`
+    returns)."""
+    fig, axes = figure(2, 2, figsize=(10, 7), sharex=True)
+    styles = ("-", "--", "-.", ":")
+    for col, (name, unit) in enumerate((("yaw_rate", "(deg/s)/deg"), ("ay", "g/deg"))):
+        for (label, r), style in zip(responses.items(), styles):
+            axes[0, col].semilogx(r["frequency_hz"], r[f"{name}_gain_db"], style, label=label)
+            axes[1, col].semilogx(r["frequency_hz"], r[f"{name}_phase_deg"], style, label=label)
+        axes[0, col].set_ylabel(f"{'r' if name == 'yaw_rate' else 'ay'} magnitude [dB {unit}]")
+        axes[1, col].set_ylabel("phase [deg]")
+        axes[1, col].set_xlabel("f [Hz]")
+        for ax in axes[:, col]:
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
