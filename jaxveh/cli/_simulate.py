@@ -98,7 +98,7 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
         "stop_reason": run.stop_reason,
     }
     if metrics is not None:
-        report |= metrics(run)
+        report |= metrics(run, car)
     report["title"] = f"{name} at {report['speed_kmh']:g} km/h, {report['chassis']} ({form} form)"
     if out_dir is not None:
         _write(out_dir, name.replace("-", "_"), run, report)
@@ -113,7 +113,7 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
     typer.echo(f"{report['title']}: {report['wall_time_s']:.2f} s (compilation included on a first run), "
                f"{report['steps']} steps" + (f"; wrote {out_dir}" if out_dir else ""))
     for key, value in report.items():
-        if key.endswith(("_s", "_pct", "_deg_s", "_g", "_deg")) and key not in ("wall_time_s", "duration_s"):
+        if key.endswith(("_s", "_pct", "_deg_s", "_g", "_deg", "_per_g")) and key not in ("wall_time_s", "duration_s"):
             typer.echo(f"  {key} = {value:.4g}")
 
 
@@ -141,7 +141,7 @@ def step_steer(
     except ParameterError as e:
         fail(str(e))
     _run("step-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet,
-         lambda run: step_steer_metrics(run.ts, run.channels, m.steering))
+         lambda run, car: step_steer_metrics(run.ts, run.channels, m.steering))
 
 
 @app.command("ramp-steer")
@@ -152,15 +152,24 @@ def ramp_steer(
     duration: float = typer.Option(10.0, "--duration", help="s"),
     rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
 ) -> None:
-    """Ramp steer (Fig. 6.13): the steering wheel turns at a constant rate from 0.5 s."""
-    from ..manoeuvre import Manoeuvre, RampSteer
+    """Ramp steer (Fig. 6.13): the steering wheel turns at a constant rate from 0.5 s;
+    constant-speed understeer, steering-wheel, roll and sideslip gradients (ISO 4138) from
+    the samples between 0.1 and 0.3 g."""
+    from ..manoeuvre import Manoeuvre, RampSteer, ramp_steer_metrics
 
     try:
         law = RampSteer(rate=math.radians(rate_deg_s), start=0.5, blend=0.1)
         m = Manoeuvre(steering=law, speed=_speed(speed_kmh), duration=duration)
     except ParameterError as e:
         fail(str(e))
-    _run("ramp-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet)
+    def metrics(run, car):
+        wheelbase = float(car.params.vehicle.a + car.params.vehicle.b)
+        try:
+            return ramp_steer_metrics(run.channels, wheelbase)
+        except ParameterError as e:  # a ramp too short or too gentle to reach 0.3 g
+            return {"metrics_error": str(e)}
+
+    _run("ramp-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points=2001)
 
 
 @app.command("sine-sweep")
@@ -186,7 +195,7 @@ def sine_sweep(
     except ParameterError as e:
         fail(str(e))
 
-    def metrics(run):
+    def metrics(run, car):
         r = frequency_response(run.ts, run.channels, f_max=f_max)
         return {"frequency_response": {k: np.asarray(v).tolist() for k, v in r.items()}}
 

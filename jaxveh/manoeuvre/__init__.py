@@ -13,7 +13,11 @@ from ._driver import (
     step_steer as step_steer,
 )
 from ._export import run_dataset as run_dataset, write_netcdf as write_netcdf
-from ._metrics import frequency_response as frequency_response, step_steer_metrics as step_steer_metrics
+from ._metrics import (
+    frequency_response as frequency_response,
+    ramp_steer_metrics as ramp_steer_metrics,
+    step_steer_metrics as step_steer_metrics,
+)
 from ._reports import skid_pad_grid as skid_pad_grid, skid_pad_report as skid_pad_report
 from ._simulate import (
     EVENTS as EVENTS,

@@ -70,3 +70,35 @@ def frequency_response(ts, channels: dict, outputs=("yaw_rate", "ay"), f_max: fl
         out[f"{name}_gain_db"] = 20.0 * np.log10(np.abs(h))
         out[f"{name}_phase_deg"] = np.rad2deg(np.unwrap(np.angle(h)))
     return out
+
+
+def ramp_steer_metrics(channels: dict, wheelbase: float, ay_range_g=(0.1, 0.3)) -> dict:
+    """Constant-speed gradients of a slow ramp steer (ISO 4138, continuous-steer method),
+    each the least-squares slope against ay (g) of the samples with ``|ay|`` in
+    ``ay_range_g``: ``understeer_gradient_deg_per_g`` of the dynamic steer angle
+    ``delta - l r / V`` (delta the mean front road-wheel angle, l ``wheelbase`` (m), r the
+    yaw rate, V the speed: the Ackermann part removed), ``steering_wheel_gradient_deg_per_g``,
+    ``roll_gradient_deg_per_g`` and ``sideslip_gradient_deg_per_g``; ``gradient_points`` used. Signs
+    as for a left turn (a right ramp gives the same gradients)."""
+    lo, hi = (float(x) for x in ay_range_g)
+    if not 0.0 <= lo < hi:
+        raise ParameterError(f"ay_range_g = {ay_range_g!r} is out of range: allowed 0 <= low < high (g)")
+    if not wheelbase > 0.0:
+        raise ParameterError(f"wheelbase = {wheelbase!r} is out of range: allowed > 0 (m)")
+    ay = np.asarray(channels["ay"], float)
+    side = 1.0 if ay[np.argmax(np.abs(ay))] >= 0.0 else -1.0
+    use = (side * ay >= lo) & (side * ay <= hi)
+    if use.sum() < 3:
+        raise ParameterError(f"the run has {int(use.sum())} samples with |ay| in [{lo:g}, {hi:g}] g: steer further "
+                             "or save more points (at least 3 needed)")
+    speed = np.asarray(channels["speed"], float)
+    kinematic = np.rad2deg(wheelbase * np.deg2rad(np.asarray(channels["yaw_rate"], float)) / speed)
+    delta = np.asarray(channels["road_wheel_angle"], float)[:, :2].mean(axis=1)
+    series = {
+        "understeer_gradient_deg_per_g": delta - kinematic,
+        "steering_wheel_gradient_deg_per_g": np.asarray(channels["steering_wheel_angle"], float),
+        "roll_gradient_deg_per_g": np.asarray(channels["roll"], float),
+        "sideslip_gradient_deg_per_g": np.asarray(channels["sideslip"], float),
+    }
+    out = {key: float(np.polyfit(side * ay[use], side * y[use], 1)[0]) for key, y in series.items()}
+    return out | {"gradient_points": int(use.sum())}
