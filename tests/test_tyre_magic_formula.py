@@ -285,3 +285,30 @@ def test_lift_off_transition_is_smooth_at_zero_load():
     up = float(dfy(jnp.asarray(floor + 1e-9)))
     down = float(dfy(jnp.asarray(floor - 1e-9)))
     assert down == pytest.approx(up, rel=0.1)  # secant vs tangent of a nearly linear curve
+
+
+def test_mirror_symmetric_tyre_is_exactly_symmetric():
+    """Every coefficient perturbed at random (the file's tyre has few asymmetric ones), then
+    :func:`mirror_symmetric`: Fy, Mz, Mx odd and Fx, My even under (alpha, gamma) ->
+    (-alpha, -gamma) to round-off, which the perturbed tyre itself is far from. Fails if the
+    list of asymmetric coefficients misses one."""
+    from jaxveh.tyre import coefficient_names, load_fsae_tyre, mirror_symmetric, tyre_forces
+
+    rng = np.random.default_rng(1)
+    tyre = load_fsae_tyre()
+    names = [n for n in coefficient_names() if n[0] in "pqrs" and n[1:3].isalpha() and n[-1].isdigit()]
+    assert len(names) > 80
+    tyre = eqx.tree_at(lambda t: tuple(getattr(t, n) for n in names), tyre,
+                       tuple(getattr(tyre, n) + 0.02 * rng.uniform(-1.0, 1.0) for n in names))
+    fz, kappa = rng.uniform(200.0, 2000.0, 200), rng.uniform(-0.3, 0.3, 200)
+    alpha, gamma = rng.uniform(-0.3, 0.3, 200), rng.uniform(-0.08, 0.08, 200)
+    parity = {"fx": 1.0, "fy": -1.0, "mx": -1.0, "my": 1.0, "mz": -1.0}
+    for t, symmetric in ((tyre, False), (mirror_symmetric(tyre), True)):
+        left = jax.vmap(lambda *x: tyre_forces(t, *x))(fz, kappa, alpha, gamma)
+        right = jax.vmap(lambda *x: tyre_forces(t, *x))(fz, kappa, -alpha, -gamma)
+        gaps = {k: float(np.max(np.abs(getattr(left, k) - s * getattr(right, k))) / np.max(np.abs(getattr(left, k))))
+                for k, s in parity.items()}
+        if symmetric:
+            assert max(gaps.values()) < 1e-12, gaps
+        else:
+            assert min(gaps.values()) > 1e-3, gaps

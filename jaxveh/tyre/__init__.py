@@ -40,8 +40,10 @@ from ._fit import (
 )
 from ._model import (
     SUPPORTED_FITTYP as SUPPORTED_FITTYP,
+    ASYMMETRIC_COEFFICIENTS as ASYMMETRIC_COEFFICIENTS,
     MagicFormulaTyre as MagicFormulaTyre,
     coefficient_names as coefficient_names,
+    mirror_symmetric as mirror_symmetric,
     stack_tyres as stack_tyres,
 )
 from ._plot import PANEL_FILES as PANEL_FILES, fig_b1_figures as fig_b1_figures, plot_fig_b1 as plot_fig_b1

@@ -279,3 +279,24 @@ def stack_tyres(tyres) -> MagicFormulaTyre:
         raise ValueError(f"stack_tyres: tyres differ in (fittyp, relaxation_model): {sorted(models)}")
     bare = [dataclasses.replace(t, extras=()) for t in tyres]
     return jax.tree.map(lambda *x: jnp.stack(x), *bare)
+
+
+#: Coefficients that make MF 5.2 differ between left and right turns: offsets and the odd
+#: terms of functions that must be even (section by section of :func:`tyre_forces`).
+ASYMMETRIC_COEFFICIENTS = (
+    "phy1", "phy2", "pvy1", "pvy2", "pey3",  # pure Fy: horizontal and vertical shifts, curvature asymmetry
+    "rhx1", "rby3", "rvy1", "rvy2",  # combined Fx and Fy: the slip-angle shift, kappa-induced side force
+    "qhz1", "qhz2", "qbz4", "qdz3", "qez4", "qdz6", "qdz7", "ssz1",  # Mz: trail shift and odd terms, offsets
+    "qsx1",  # Mx offset
+)
+
+
+def mirror_symmetric(tyre: MagicFormulaTyre) -> MagicFormulaTyre:
+    """``tyre`` with :data:`ASYMMETRIC_COEFFICIENTS` zeroed (every other one kept; stacked
+    tyres too): Fy, Mz and Mx become odd and Fx, My even under ``(alpha, gamma) ->
+    (-alpha, -gamma)`` at any slip ratio and load, so a car on such tyres (and with a
+    symmetric chassis) answers a right turn with the mirror image of a left one. For
+    symmetry checks and studies that want the tyre's mean behaviour without its ply steer and
+    conicity."""
+    return eqx.tree_at(lambda t: tuple(getattr(t, n) for n in ASYMMETRIC_COEFFICIENTS), tyre,
+                       tuple(jnp.zeros_like(getattr(tyre, n)) for n in ASYMMETRIC_COEFFICIENTS))
