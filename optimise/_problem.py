@@ -22,6 +22,7 @@ import numpy as np
 import optax
 
 from jaxveh import ParameterError
+from jaxveh.params import get_at, set_all
 
 
 class Variable(NamedTuple):
@@ -34,27 +35,16 @@ class Variable(NamedTuple):
 
 
 def get_leaf(params, path: str):
-    """Leaf of ``params`` at dotted attribute ``path``; ``ParameterError`` (a ``ValueError``)
+    """Value of ``params`` at ``path`` (dotted fields, optional indices: ``"kC"``,
+    ``"arb_rates[0]"``; :func:`jaxveh.params.get_at`); ``ParameterError`` (a ``ValueError``)
     if it does not exist or is a derived property rather than a stored field."""
-    node = params
-    for part in path.split("."):
-        if isinstance(getattr(type(node), part, None), property):
-            raise ParameterError(
-                f"parameter path {path!r}: {type(node).__name__}.{part} is derived from other fields "
-                f"(a property), not a leaf; vary the fields it is computed from"
-            )
-        if not hasattr(node, part):
-            raise ParameterError(f"parameter path {path!r}: {type(node).__name__} has no field {part!r}")
-        node = getattr(node, part)
-    return node
+    return get_at(params, path)
 
 
 def set_leaves(params, values: dict):
-    """Copy of ``params`` with the leaves at the dotted paths of ``values`` replaced."""
-    for path, value in values.items():
-        get_leaf(params, path)
-        params = eqx.tree_at(lambda p, path=path: get_leaf(p, path), params, jnp.asarray(value, dtype=jnp.float64))
-    return params
+    """Copy of ``params`` with the values at the paths of ``values`` replaced
+    (:func:`jaxveh.params.set_all`)."""
+    return set_all(params, values)
 
 
 def target(fn: Callable, value: float, scale: float = 1.0) -> Callable:

@@ -218,6 +218,7 @@ def test_left_and_right_steps_mirror_each_other(runs):
     (["--form", "quick"], "form = 'quick'"),
     (["--steer-deg", "500"], "StepSteer.amplitude"),
     (["--modes", "21"], "modes = 21"),
+    (["--param", "chassis.stiffness_scale[9]=2"], "do not fit the shape [6]"),
 ])
 def test_cli_refuses_bad_options(args, match):
     result = CliRunner().invoke(app, ["simulate", "step-steer", *args])

@@ -18,7 +18,7 @@ from jaxveh.cli import app
 from jaxveh.manoeuvre import CONDITIONS, skid_pad, steady_state
 from jaxveh.manoeuvre._steady import compiled_core, condition_kinds
 from jaxveh.multibody import rotation_matrix
-from jaxveh.vehicle import SetupError, load_car, static_corner_loads
+from jaxveh.vehicle import SetupError, load_car, static_corner_loads, with_params
 
 RADIUS = 50.0
 #: 0.11 ... 0.59 g at speeds half-way between the aero table's knots (1 m/s apart, piecewise
@@ -152,12 +152,25 @@ def test_cli_skid_pad_json_and_files(car, pad, tmp_path):
     assert header[:3] == ["ay_g", "speed_kmh", "steering_wheel_angle_deg"] and "fz_rr_n" in header
     assert (tmp_path / "skid_pad.png").stat().st_size > 10_000
     assert json.loads((tmp_path / "skid_pad.json").read_text())["points"] == 6
+    # --param: a stiffer front anti-roll bar and first chassis mode, as the API's with_params
+    settings = {"arb_rates[0]": 2.0 * float(car.params.arb_rates[0]), "chassis.stiffness_scale[0]": 3.0}
+    args = [a for path, value in settings.items() for a in ("--param", f"{path}={value!r}")]
+    result = CliRunner().invoke(app, ["simulate", "skid-pad", "--ay-max-g", "0.3", "--json", *args])
+    assert result.exit_code == 0, result.output
+    changed = json.loads(result.stdout)
+    assert changed["params"] == settings
+    api = skid_pad(with_params(car, settings), RADIUS, np.arange(1, 7) * 0.05 * GRAVITY)
+    np.testing.assert_allclose(changed["understeer_gradient_deg_per_g"], float(api.understeer_gradient[0]), rtol=1e-9)
+    assert abs(changed["understeer_gradient_deg_per_g"] - report["understeer_gradient_deg_per_g"]) > 1e-4
 
 
 @pytest.mark.parametrize("args, match", [
     (["--form", "library"], "fast car only"),
     (["--radius", "0"], "--radius must be > 0"),
     (["--ay-step-g", "0"], "ay step = 0.0 g"),
+    (["--param", "arb_rate[0]=1"], "CarParams has no field 'arb_rate'"),
+    (["--param", "coupling"], "expected PATH=VALUE"),
+    (["--param", "coupling=2"], "coupling must lie in [0, 1]"),
 ])
 def test_cli_skid_pad_refuses_bad_options(args, match):
     result = CliRunner().invoke(app, ["simulate", "skid-pad", *args, "--json"])

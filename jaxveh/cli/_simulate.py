@@ -22,6 +22,29 @@ RtolOpt = typer.Option(1e-4, "--rtol", help="relative tolerance of the step-size
 JsonOpt = typer.Option(False, "--json", help="print only JSON on stdout")
 OutOpt = typer.Option(None, "--out", help="write JSON, CSV, netCDF (manoeuvres) and a PNG into this folder")
 QuietOpt = typer.Option(False, "--quiet", help="no progress messages on stderr")
+ParamOpt = typer.Option(None, "--param", help="set a car parameter, PATH=VALUE (repeatable): arb_rates[0]=30000, "
+                        "chassis.stiffness_scale[0]=2, coupling=0.5 (paths into CarParams, SI units)")
+
+
+def _params(settings) -> dict:
+    """``{path: value}`` from ``--param PATH=VALUE`` options."""
+    out = {}
+    for item in settings or ():
+        path, sep, value = item.rpartition("=")
+        try:
+            if not sep or not path.strip():
+                raise ValueError
+            out[path.strip()] = float(value)
+        except ValueError:
+            fail(f"--param {item!r}: expected PATH=VALUE with a number, e.g. arb_rates[0]=30000")
+    return out
+
+
+def _load(vehicle, modes, form, settings):
+    """The car with ``--param`` settings applied (checked)."""
+    from ..vehicle import load_car, with_params
+
+    return with_params(load_car(vehicle, modes=modes, form=form), _params(settings))
 
 
 def _compilation_cache() -> None:
@@ -69,16 +92,15 @@ def _write(out_dir: Path, name: str, run, report: dict) -> None:
 
 
 def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics=None,
-         points: int = 501, figures=None):
+         points: int = 501, figures=None, settings=None):
     """Simulate, report (plus ``metrics(run)``), write the files (plus ``figures(report)``:
     name -> figure) and print."""
     from ..manoeuvre import simulate
-    from ..vehicle import load_car
 
     _compilation_cache()
     modes = 0 if rigid else modes
     try:
-        car = load_car(vehicle, modes=modes, form=form)
+        car = _load(vehicle, modes, form, settings)
         _say(quiet, f"jaxveh: {name}, {modes} chassis modes, {form} form (the first run compiles for minutes)")
         run = simulate(car, manoeuvre, rtol=rtol, points=points)
     except (ParameterError, RuntimeError) as e:
@@ -96,6 +118,7 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
         "rejected_steps": int(run.rejected_steps),
         "max_constraint_residual_m": float(np.max(np.asarray(run.channels["constraint_residual"]))),
         "stop_reason": run.stop_reason,
+        "params": _params(settings),
     }
     if metrics is not None:
         report |= metrics(run, car)
@@ -130,6 +153,7 @@ def step_steer(
     steer_deg: float = typer.Option(6.0, "--steer-deg", help="final steering-wheel angle, deg (negative: right)"),
     duration: float = typer.Option(5.0, "--duration", help="s"),
     rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
 ) -> None:
     """Step steer (Fig. 7.6): the steering wheel turns to --steer-deg between 0.5 and 0.7 s
     (a cubic with continuous rate) at a held speed; yaw-rate response time, overshoot and
@@ -141,7 +165,7 @@ def step_steer(
     except ParameterError as e:
         fail(str(e))
     _run("step-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet,
-         lambda run, car: step_steer_metrics(run.ts, run.channels, m.steering))
+         lambda run, car: step_steer_metrics(run.ts, run.channels, m.steering), settings=param)
 
 
 @app.command("ramp-steer")
@@ -151,6 +175,7 @@ def ramp_steer(
     rate_deg_s: float = typer.Option(4.0, "--rate-deg-s", help="steering-wheel rate, deg/s (negative: right)"),
     duration: float = typer.Option(10.0, "--duration", help="s"),
     rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
 ) -> None:
     """Ramp steer (Fig. 6.13): the steering wheel turns at a constant rate from 0.5 s;
     constant-speed understeer, steering-wheel, roll and sideslip gradients (ISO 4138) from
@@ -169,7 +194,8 @@ def ramp_steer(
         except ParameterError as e:  # a ramp too short or too gentle to reach 0.3 g
             return {"metrics_error": str(e)}
 
-    _run("ramp-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points=2001)
+    _run("ramp-steer", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points=2001,
+         settings=param)
 
 
 @app.command("sine-sweep")
@@ -180,6 +206,7 @@ def sine_sweep(
     f_max: float = typer.Option(15.0, "--f-max", help="end frequency, Hz (Fig. 6.15: 15)"),
     duration: float = typer.Option(120.0, "--duration", help="sweep time, s (Table 6.6: 120)"),
     rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
 ) -> None:
     """Swept sine (Fig. 6.15): frequency rising linearly from 0 to --f-max over --duration;
     yaw-rate and ay frequency responses per steering-wheel angle by FFT with a Gaussian
@@ -204,7 +231,7 @@ def sine_sweep(
         return {"frf": plots.plot_frequency_response({report["chassis"]: r}, title=report["title"])}
 
     points = max(501, math.ceil(10.0 * f_max * duration) + 1)
-    _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points, figures)
+    _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points, figures, param)
 
 
 @app.command("skid-pad")
@@ -213,14 +240,13 @@ def skid_pad(
     radius: float = typer.Option(50.0, "--radius", help="circle radius, m (Fig. 7.5: 50)"),
     ay_max_g: float = typer.Option(2.5, "--ay-max-g", help="highest lateral acceleration tried, g"),
     step_g: float = typer.Option(0.05, "--ay-step-g", help="lateral acceleration step, g (also the first point)"),
-    out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt, param: list[str] = ParamOpt,
 ) -> None:
     """Skid-pad (Fig. 7.5): the car's steady states on a circle by root finding, from
     --ay-step-g to the grip limit; understeer gradient (deg/g, at the first point), dynamic
     steer angle, steering sensitivity, sideslip and roll against ay."""
     from .. import plots
     from ..manoeuvre import skid_pad_report
-    from ..vehicle import load_car
 
     _compilation_cache()
     modes = 0 if rigid else modes
@@ -229,14 +255,14 @@ def skid_pad(
     if not radius > 0.0:
         fail(f"--radius must be > 0 m, got {radius:g}")
     try:
-        car = load_car(vehicle, modes=modes, form=form)
+        car = _load(vehicle, modes, form, param)
         _say(quiet, f"jaxveh: skid-pad R = {radius:g} m, {modes} chassis modes (the first run compiles for minutes)")
         report = skid_pad_report(car, radius, ay_max_g, step_g)
     except (ParameterError, RuntimeError) as e:
         fail(str(e))
     chassis = "rigid" if modes == 0 else f"flexible, {modes} modes"
     report = {"manoeuvre": "skid-pad", "method": "steady states by root finding", "form": form, "modes": modes,
-              "chassis": chassis} | report
+              "chassis": chassis, "params": _params(param)} | report
     report["title"] = f"skid-pad R = {radius:g} m, {chassis}"
     if out_dir is not None:
         out_dir = Path(out_dir)

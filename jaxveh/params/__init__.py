@@ -40,6 +40,7 @@ from ._checks import (
     checked_field as checked_field,
     require as require,
 )
+from ._paths import get_at as get_at, parse_path as parse_path, set_all as set_all, set_at as set_at
 from ._schema import (
     UNIT_TO_SI as UNIT_TO_SI,
     ParameterError as ParameterError,

@@ -38,6 +38,7 @@ from ._car import (
     system_params as system_params,
     total_mass as total_mass,
     wheel_centres as wheel_centres,
+    with_params as with_params,
     with_rest_preloads as with_rest_preloads,
 )
 from ._contact import (

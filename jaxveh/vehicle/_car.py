@@ -36,7 +36,7 @@ from jaxtyping import Array, Float
 from .. import fe
 from .._core import GRAVITY, ParameterError, as_float
 from ..multibody import FlexibleBody, RigidBody, System, SystemBuilder, SystemParams, TimeInputs
-from ..params import HARD_POINT_NAMES, CarFile, VehicleData, hard_points_vehicle_frame, read_car_file
+from ..params import HARD_POINT_NAMES, CarFile, VehicleData, hard_points_vehicle_frame, read_car_file, set_all
 from ..multibody._system import checked_params
 from ..tyre import check_tyre, fsae_tir_path, read_tir, stack_tyres
 from ._aero import AeroLoads, AeroMap, aero_map_from_coefficients
@@ -238,6 +238,15 @@ def check_car(car: Car) -> Car:
             check()
     checked_params(car.system, system_params(car))
     return car
+
+
+def with_params(car: Car, values: dict) -> Car:
+    """Copy of ``car`` with the :class:`CarParams` values at the paths of ``values`` set
+    (``{"arb_rates[0]": 3e4, "chassis.stiffness_scale[0]": 2.0, "coupling": 0.5}``; paths
+    as :func:`jaxveh.params.set_at`, relative to ``car.params``), then checked
+    (:func:`check_car`). The structure is unchanged: no recompilation."""
+    params = set_all(car.params, values)
+    return check_car(eqx.tree_at(lambda c: c.params, car, params))
 
 
 def system_params(car: Car) -> SystemParams:
