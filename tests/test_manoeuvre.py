@@ -197,16 +197,21 @@ def _mirrored(channels):
 def test_left_and_right_steps_mirror_each_other(runs):
     """The rigid car on mirror-symmetric tyres (``jaxveh.tyre.mirror_symmetric``; the file's
     tyre has an asymmetric aligning moment): a right step is the mirror image of a left one
-    on every channel to 1e-9 of its largest value (the fixture's compiled program serves)."""
+    on every channel to 1e-7 of its largest value, at rtol 1e-10 (the fixture's compiled
+    program serves). The two runs take different step sequences (rounding differs between
+    the sides): at rtol 1e-8 the small longitudinal channels (ax, fx, slip ratio) differ by
+    up to 1.5e-6 of their range, at 1e-10 the worst is 3e-8 (ax) and the large channels
+    (speed, steering, road-wheel angles, spring lengths) agree to 1e-9."""
     car = load_car(modes=0)
     car = eqx.tree_at(lambda c: c.params.tyres, car, mirror_symmetric(car.params.tyres))
-    left, right = (_channels(simulate(car, step_steer(angle=s * ANGLE), rtol=TIGHT)) for s in (1.0, -1.0))
+    left, right = (_channels(simulate(car, step_steer(angle=s * ANGLE), rtol=1e-10)) for s in (1.0, -1.0))
     mirrored = _mirrored(left)
     for name, value in right.items():
         if name == "modes":
             continue
         scale = np.max(np.abs(value))
-        assert np.max(np.abs(value - mirrored[name])) <= 1e-9 * scale, name
+        tolerance = 1e-9 if name in ("speed", "steering_wheel_angle", "road_wheel_angle", "spring_length") else 1e-7
+        assert np.max(np.abs(value - mirrored[name])) <= tolerance * scale, name
     assert np.max(np.abs(left["yaw_rate"])) > 10.0  # a real turn
 
 

@@ -12,8 +12,9 @@ from jaxveh.cli import app
 from jaxveh.manoeuvre import Manoeuvre, RampSteer, ramp_steer_metrics, simulate, steady_state
 from jaxveh.vehicle import load_car
 
-# Fig. 6.13's speed and the CLI's defaults (4 deg/s from 0.5 s, 2001 points); 4 s reach about 0.45 g.
-SPEED, RATE_DEG_S, DURATION, POINTS = 40.0 / 3.6, 4.0, 4.0, 2001
+# Fig. 6.13's speed, half the CLI's default rate (2 deg/s from 0.5 s; 0.065 g/s), its 2001
+# points; 7 s reach about 0.4 g.
+SPEED, RATE_DEG_S, DURATION, POINTS = 40.0 / 3.6, 2.0, 7.0, 2001
 
 
 def _fake_channels(ay, ku_deg_per_g, wheelbase, speed=SPEED):
@@ -63,9 +64,10 @@ def _steady_gradients(car, wheelbase):
 
 @pytest.mark.slow
 def test_slow_ramp_gradients_equal_the_steady_states(ramp):
-    """The ramp (0.13 g/s) is quasi-static: its steering-wheel, roll and sideslip gradients
+    """The ramp (0.065 g/s) is quasi-static: its steering-wheel, roll and sideslip gradients
     equal the steady states' within 1 %; its understeer gradient, a small difference of two
-    large angles on this near-neutral car, within 1 % of the Ackermann gradient l g / V^2."""
+    large angles on this near-neutral car, within 1 % of the Ackermann gradient l g / V^2.
+    (At the CLI's 4 deg/s the sideslip gradient lags by 1.06 %: the ramp's own dynamics.)"""
     car, run = ramp
     assert run.stop_reason == "completed"
     wheelbase = float(car.params.vehicle.a + car.params.vehicle.b)
@@ -81,7 +83,7 @@ def test_slow_ramp_gradients_equal_the_steady_states(ramp):
 def test_cli_ramp_steer_reports_the_gradients(ramp):
     """The CLI's ramp (the fixture's compiled program serves) reports the API's gradients."""
     result = CliRunner().invoke(app, ["simulate", "ramp-steer", "--rigid", "--duration", str(DURATION),
-                                      "--rtol", "1e-6", "--json"])
+                                      "--rate-deg-s", str(RATE_DEG_S), "--rtol", "1e-6", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     car, run = ramp

@@ -103,22 +103,25 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
         d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
         return FastState(d.q_dot, d.u_dot, d.aux_dot)
 
-    def save(t, s, args):
+    def channels(t, s):
         d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
         out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], manoeuvre.steering(t))
         return out | {"constraint_residual": d.link_residual}
 
     terms = _imex_terms(field, s0, car.n_modes) if solver == "kencarp4" else diffrax.ODETerm(field)
     conditions = tuple(lambda t, s, args, fn=fn, **kw: fn(s.q, s.u) for fn in (_rolled_over, _spun))
+    # the states at the save times (dense output), then the channels in one vectorised pass:
+    # a save function would be traced five times by Diffrax and sit inside the step loop
     sol = diffrax.diffeqsolve(
-        terms, _solver(solver), 0.0, manoeuvre.duration, FIRST_STEP, s0,
-        saveat=diffrax.SaveAt(ts=ts, fn=save), event=diffrax.Event(conditions),
-        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol), max_steps=max_steps, throw=False)
+        terms, _solver(solver), 0.0, manoeuvre.duration, FIRST_STEP, s0, saveat=diffrax.SaveAt(ts=ts),
+        event=diffrax.Event(conditions), stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol),
+        max_steps=max_steps, throw=False)
     rolled, spun = sol.event_mask
     status = jnp.where(sol.result == diffrax.RESULTS.successful, 0,
                        jnp.where(sol.result == diffrax.RESULTS.event_occurred, 1, 2))
-    valid = jnp.isfinite(sol.ys["yaw_rate"])  # Diffrax fills the save times after a stop with inf
-    return sol.ys, dict(sol.stats) | {"event": _event_code(rolled, spun), "valid": valid}, status
+    valid = jnp.isfinite(sol.ys.q[:, 0])  # Diffrax fills the save times after a stop with inf
+    states = jax.tree.map(lambda x: _hold_after_stop(x, valid), sol.ys)
+    return jax.vmap(channels)(ts, states), dict(sol.stats) | {"event": _event_code(rolled, spun), "valid": valid}, status
 
 
 def _rolled_over(q, u):
