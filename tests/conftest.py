@@ -10,7 +10,9 @@ that module then compile again: slower, never wrong).
 
 Compiled executables also go to a persistent compilation cache (``.pytest_cache/jax``,
 entries that took over a second to compile): a later module, worker or run that compiles
-the same program (the car's static set-up, say) loads it instead.
+the same program (the car's static set-up, say) loads it instead. Programs with run-time
+checks (host callbacks) are not stored; the car's manoeuvre and steady-state programs are
+traced without them (``jaxveh._core.run_time_checks_off``), so they are.
 """
 
 import gc
