@@ -54,3 +54,5 @@ def test_with_params_checks_the_result(car):
         with_params(car, {"coupling": 1.5})
     with pytest.raises(ParameterError, match="ModalBody.stiffness_scale"):
         with_params(car, {"chassis.stiffness_scale[3]": -1.0})
+    with pytest.raises(ParameterError, match="arb_rates"):
+        with_params(car, {"arb_rates[1]": -10.0})

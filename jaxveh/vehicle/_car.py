@@ -34,7 +34,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .. import fe
-from .._core import GRAVITY, ParameterError, as_float
+from .._core import GRAVITY, ParameterError, as_float, check_range
 from ..multibody import FlexibleBody, RigidBody, System, SystemBuilder, SystemParams, TimeInputs
 from ..params import HARD_POINT_NAMES, CarFile, VehicleData, hard_points_vehicle_frame, read_car_file, set_all
 from ..multibody._system import checked_params
@@ -225,13 +225,15 @@ def _build_system(vehicle: VehicleData, modal) -> tuple[System, SystemParams]:
 
 def check_car(car: Car) -> Car:
     """Run every check the car's compiled programs would run on its parameters: the tyres'
-    coefficients, the chassis's modal stiffness multipliers and damping, and the library
-    parameters (masses, inertias, coupling, link lengths, points, gravity). Concrete
+    coefficients, the chassis's modal stiffness multipliers and damping, the anti-roll-bar
+    rates (>= 0) and the library parameters (masses, inertias, coupling, link lengths,
+    points, gravity). Concrete
     values raise :class:`~jaxveh.ParameterError` naming the value (traced ones fail at run
     time); returns ``car``. Entry points that compile the car without run-time checks
     (:func:`jaxveh._core.run_time_checks_off`) call this first, so a leaf set out of range
     with ``eqx.tree_at`` is still refused by name."""
     p = car.params
+    check_range("arb_rates (N m/rad, front and rear)", p.arb_rates, low=0.0)
     check_tyre(p.tyres)
     if p.chassis is not None:
         for check in (p.chassis._scale, p.chassis._alpha, p.chassis._beta, p.chassis._zeta):
