@@ -278,7 +278,5 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
         reason = f"solver failure {after}"
         if throw:
             raise RuntimeError(f"the {form} car's integration failed: {reason}")
-    if not valid.all():  # the library car's rule for save times after a stop
-        channels = {k: _hold_after_stop(jnp.asarray(v), jnp.asarray(valid)) for k, v in channels.items()}
     return CarRun(ts=ts, channels=channels, steps=stats["num_steps"], rejected_steps=stats["num_rejected_steps"],
                   status=jnp.asarray(status), form=form, stop_reason=reason, wall_s=wall, valid=jnp.asarray(valid))
