@@ -1,0 +1,33 @@
+"""Chapter-7 analyses of the chapter-6 car: lateral load transfer and its distribution χ
+(section 7.1.2, Fig. 7.2) against ay, the roll stiffness distribution λ, the number of
+chassis modes and each mode's stiffness, beside the chapter-3 model (eqs. 3.2-3.6) fed
+with the car's own parameters. See docs/analysis.md."""
+
+from ._chapter3 import (
+    Chapter3Parameters as Chapter3Parameters,
+    analytic_vehicle as analytic_vehicle,
+    chapter3_chi as chapter3_chi,
+    chapter3_load_transfer as chapter3_load_transfer,
+    chapter3_parameters as chapter3_parameters,
+    frame_torsional_stiffness as frame_torsional_stiffness,
+    roll_centre_heights as roll_centre_heights,
+    static_sink as static_sink,
+    with_lambda as with_lambda,
+)
+from ._load_transfer import (
+    AY_GRID_G as AY_GRID_G,
+    LAMBDA_RANGE as LAMBDA_RANGE,
+    LOW_AY_G as LOW_AY_G,
+    MU_RANGE as MU_RANGE,
+    SKID_PAD_RADIUS as SKID_PAD_RADIUS,
+    LoadTransfer as LoadTransfer,
+    arb_rates_for_distribution as arb_rates_for_distribution,
+    chi_mode_stiffness_gradient as chi_mode_stiffness_gradient,
+    chi_vs_lambda as chi_vs_lambda,
+    chi_vs_mode_stiffness as chi_vs_mode_stiffness,
+    chi_vs_modes as chi_vs_modes,
+    lambda_designs as lambda_designs,
+    load_transfer as load_transfer,
+    load_transfer_batch as load_transfer_batch,
+    mode_stiffness_designs as mode_stiffness_designs,
+)
