@@ -18,6 +18,7 @@ from ._load_transfer import (
     AY_GRID_G as AY_GRID_G,
     LAMBDA_RANGE as LAMBDA_RANGE,
     LOW_AY_G as LOW_AY_G,
+    LOW_AY_PAIR_G as LOW_AY_PAIR_G,
     MU_RANGE as MU_RANGE,
     SKID_PAD_RADIUS as SKID_PAD_RADIUS,
     LoadTransfer as LoadTransfer,
@@ -31,3 +32,4 @@ from ._load_transfer import (
     load_transfer_batch as load_transfer_batch,
     mode_stiffness_designs as mode_stiffness_designs,
 )
+from ._reports import lltd_report as lltd_report

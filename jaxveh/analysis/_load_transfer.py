@@ -9,10 +9,19 @@ axle is a quarter of the change of its right-less-left tyre load between the two
     ΔFz_axle(ay) = [(Fz_right - Fz_left)(+ay) - (Fz_right - Fz_left)(-ay)] / 4      (N),
 
 which removes the small static left/right differences that the tyres' asymmetric offsets
-leave at ay = 0 (and every term even in ay). χ = ΔFzF / (ΔFzF + ΔFzR), the front axle's
-share (the thesis's χ = ΔFzF / ΔFz). "χ at low ay" is χ at :data:`LOW_AY_G`; its error
-from the limit ay -> 0 is about 0.14 ay^2 (ay in g: 3e-4 at 0.05 g, measured on the rigid
-car).
+leave at ay = 0 (and every term even in ay). The secant χ = ΔFzF / (ΔFzF + ΔFzR) at one ay
+still holds a term constant in ay on a circle of fixed radius: the front wheels are
+steered by the kinematic angle l / R however small ay is, and the steering geometry
+(caster, kingpin inclination) jacks the car diagonally by an amount odd in the steer angle,
+lowering the front transfer and raising the rear by ~0.1 N on R = 50 m (χ then falls as
+1/ay at low ay: 0.4936 at 0.05 g, 0.5015 at 0.1 g on the rigid car). "χ at low ay" is
+therefore the incremental share between the first two lateral accelerations,
+
+    χ = Δ(ΔFzF) / (Δ(ΔFzF) + Δ(ΔFzR))     between :data:`LOW_AY_PAIR_G` (0.05 and 0.1 g),
+
+the slope ratio of Fig. 7.2a's straight lines, which the chapter-3 model describes (it has
+no steering); it equals the secant χ at fixed speed and vanishing ay at high speed without
+aero (0.5096 vs 0.5090 at 30 m/s, rigid car).
 
 Every sweep over designs is one vmapped, compiled call (one program per chassis mode
 count and batch size): the roll-stiffness distribution λ through the anti-roll bars
@@ -35,11 +44,13 @@ from ..vehicle import car_rates, check_car, installation_ratios, load_car
 
 #: The skid-pad radius of Fig. 7.2 (m).
 SKID_PAD_RADIUS = 50.0
-#: "Low" lateral acceleration (g) at which χ is reported.
-LOW_AY_G = 0.05
-#: Lateral accelerations (g) of the load-transfer curve (Fig. 7.2a); the first is
-#: :data:`LOW_AY_G`.
-AY_GRID_G = (0.05, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2)
+#: The two "low" lateral accelerations (g) between which χ is reported (module docs).
+LOW_AY_PAIR_G = (0.05, 0.1)
+#: The lower of them (g).
+LOW_AY_G = LOW_AY_PAIR_G[0]
+#: Lateral accelerations (g) of the load-transfer curve (Fig. 7.2a); the first two are
+#: :data:`LOW_AY_PAIR_G`.
+AY_GRID_G = (0.05, 0.1, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2)
 #: λ of the roll-stiffness sweep (Fig. 7.2b).
 LAMBDA_RANGE = (0.2, 0.8)
 #: Modal stiffness multipliers µ of the single-mode sweep (Fig. 7.2d), log spaced.
@@ -51,7 +62,7 @@ MAX_STEPS = 64
 class LoadTransfer(eqx.Module):
     """Load transfer of one car (or of a batch, with a leading axis on every field):
     ``ay`` (m/s^2, > 0), per-wheel transfers ``front`` and ``rear`` (N; module docs),
-    ``chi`` = front / (front + rear) at each ay, the right-less-left load differences
+    ``chi`` = front / (front + rear) at each ay (the secant share), the right-less-left load differences
     ``diff_left`` (turning left, +ay) and ``diff_right`` (turning right, -ay), shape
     ``(n_ay, 2)`` (front, rear axle; N), and ``ok`` (both turns converged)."""
 
@@ -65,8 +76,8 @@ class LoadTransfer(eqx.Module):
 
     @property
     def chi_low_ay(self) -> Float[Array, "..."]:
-        """χ at the first (lowest) ay."""
-        return self.chi[..., 0]
+        """χ at low ay: the incremental share between the first two ay (module docs)."""
+        return _incremental(self.front, self.rear)
 
 
 def _transfers(car, ay, radius, max_steps: int = MAX_STEPS) -> LoadTransfer:
@@ -86,6 +97,11 @@ def _transfers(car, ay, radius, max_steps: int = MAX_STEPS) -> LoadTransfer:
                         diff_right=d_right, ok=res.ok[:n] & res.ok[n:])
 
 
+def _incremental(front, rear):
+    d_front, d_rear = front[..., 1] - front[..., 0], rear[..., 1] - rear[..., 0]
+    return d_front / (d_front + d_rear)
+
+
 def _with(car, params):
     return eqx.tree_at(lambda c: c.params, car, params)
 
@@ -99,7 +115,7 @@ _compiled_batch = eqx.filter_jit(_batched)
 
 
 def _chi_low(car, ay, radius):
-    return _transfers(car, ay[None], radius).chi[0]
+    return _transfers(car, ay, radius).chi_low_ay
 
 
 def _stack(params_list):
@@ -108,9 +124,9 @@ def _stack(params_list):
 
 def _check_ay(ay_g) -> np.ndarray:
     ay_g = np.atleast_1d(np.asarray(ay_g, float))
-    if ay_g.ndim != 1 or ay_g.size < 1 or not np.all(np.isfinite(ay_g)) or not np.all(ay_g > 0.0):
-        raise ParameterError(f"ay_g = {ay_g.tolist()!r} is out of range: allowed a non-empty sequence of lateral "
-                             "accelerations > 0 (g)")
+    if ay_g.ndim != 1 or ay_g.size < 2 or not np.all(np.isfinite(ay_g)) or not np.all(ay_g > 0.0):
+        raise ParameterError(f"ay_g = {ay_g.tolist()!r} is out of range: allowed a sequence of at least two "
+                             "lateral accelerations > 0 (g), the first two giving χ at low ay")
     return ay_g
 
 
@@ -210,21 +226,21 @@ def mode_stiffness_designs(car, mus):
 # ---- the analyses of Fig. 7.2 ---------------------------------------------------------------
 
 
-def chi_vs_lambda(car, lams, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_G) -> Float[Array, " n"]:
-    """χ at ``ay_g`` (g) against the roll stiffness distribution ``lams`` (Fig. 7.2b), one
+def chi_vs_lambda(car, lams, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_PAIR_G) -> Float[Array, " n"]:
+    """χ between the two ``ay_g`` (g) against the roll stiffness distribution ``lams`` (Fig. 7.2b), one
     vmapped call; λ set through the anti-roll bars (:func:`arb_rates_for_distribution`)."""
     return load_transfer_batch(car, lambda_designs(car, lams), ay_g, radius).chi_low_ay
 
 
-def chi_vs_mode_stiffness(car, mus, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_G) -> Float[Array, "n_modes n_mu"]:
-    """χ at ``ay_g`` (g) with each single mode's stiffness multiplied by each µ of ``mus``
+def chi_vs_mode_stiffness(car, mus, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_PAIR_G) -> Float[Array, "n_modes n_mu"]:
+    """χ between the two ``ay_g`` (g) with each single mode's stiffness multiplied by each µ of ``mus``
     (> 0; Fig. 7.2d), one vmapped call: row i is mode i (0-based)."""
     chi = load_transfer_batch(car, mode_stiffness_designs(car, mus), ay_g, radius).chi_low_ay
     return chi.reshape(car.n_modes, -1)
 
 
-def chi_vs_modes(max_modes: int = 6, path=None, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_G) -> Float[Array, " n"]:
-    """χ at ``ay_g`` (g) of the car file ``path`` (default: the shipped car) with 0 (rigid)
+def chi_vs_modes(max_modes: int = 6, path=None, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_PAIR_G) -> Float[Array, " n"]:
+    """χ between the two ``ay_g`` (g) of the car file ``path`` (default: the shipped car) with 0 (rigid)
     to ``max_modes`` chassis modes (Fig. 7.2c). Each mode count is its own structure and so
     its own compiled program (about a minute or two each on two cores)."""
     if isinstance(max_modes, bool) or not isinstance(max_modes, (int, np.integer)) or not 0 <= max_modes <= 20:
@@ -237,13 +253,13 @@ _grad_chi = eqx.filter_jit(eqx.filter_grad(lambda scale, car, ay, radius: _chi_l
     eqx.tree_at(lambda c: c.params.chassis.stiffness_scale, car, scale), ay, radius)))
 
 
-def chi_mode_stiffness_gradient(car, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_G) -> Float[Array, " n_modes"]:
-    """``d χ / d µ_i`` (per unit multiplier) of χ at ``ay_g`` (g) with respect to each
+def chi_mode_stiffness_gradient(car, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_PAIR_G) -> Float[Array, " n_modes"]:
+    """``d χ / d µ_i`` (per unit multiplier) of χ between the two ``ay_g`` (g) with respect to each
     mode's stiffness multiplier, at the car's own multipliers, by ``jax.grad`` through the
     root finding (implicit function theorem)."""
     check_x64()
     _check_modal(car)
-    ay = jnp.asarray(float(_check_ay(ay_g)[0]) * GRAVITY)
+    ay = jnp.asarray(_check_ay(ay_g)[:2] * GRAVITY)
     radius = jnp.asarray(_check_radius(radius))
     with run_time_checks_off():
         return _grad_chi(car.params.chassis.stiffness_scale, check_car(car), ay, radius)
