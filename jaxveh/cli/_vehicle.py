@@ -141,3 +141,38 @@ def roll(vehicle: Path = VehicleOpt, modes: int = ModesOpt, points: int = Points
 
     _run_rig("roll", veh.roll_report, vehicle, modes, points, angle, loaded, out, as_json, "roll_deg",
              plots.plot_roll)
+
+
+RigidOpt = typer.Option(False, "--rigid", help="rigid chassis (same as --modes 0)")
+
+
+@vehicle_app.command()
+def lltd(vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt,
+         radius: float = typer.Option(50.0, "--radius", help="skid-pad radius (m)"),
+         as_json: bool = JsonOpt, out: Path = OutOpt) -> None:
+    """Lateral load transfer distribution χ (front share) of the car on the skid-pad at low
+    ay (steady states by root finding) beside the chapter-3 model's χ (eqs. 3.4-3.6) for the
+    car's own roll stiffnesses and geometry, and the load transfer against ay (Fig. 7.2a)."""
+    from ..analysis import lltd_report
+
+    try:
+        report = lltd_report(_car(vehicle, 0 if rigid else modes), radius)
+    except _errors() as e:
+        fail(str(e))
+    if out is not None:
+        out = Path(out)
+        write_json(report, out / "lltd.json")
+        c = report["curve"]
+        keys = [k for k in c if k != "ay_g"]
+        rows = np.column_stack([c["ay_g"]] + [np.asarray(c[k], float) for k in keys])
+        np.savetxt(out / "lltd.csv", rows, delimiter=",", header=",".join(["ay_g"] + keys), comments="")
+    if as_json:
+        emit_json(report)
+        return
+    typer.echo(f"{report['chassis']}: chi {report['chi_low_ay']:.4f} at low ay "
+               f"({report['low_ay_g'][0]:g}-{report['low_ay_g'][1]:g} g) on R = "
+               f"{report['radius_m']:g} m (lambda {report['lam']:.3f}, mu {report['mu']:.3f})")
+    typer.echo(f"chapter 3: eq. 3.4 rigid {report['chi_eq_3_4_rigid']:.4f}, eq. 3.5 flexible "
+               f"{report['chi_eq_3_5_flexible']:.4f}; eq. 3.6 (mean track) rigid "
+               f"{report['chi_eq_3_6_rigid_mean_track']:.4f}, flexible {report['chi_eq_3_6_flexible_mean_track']:.4f}"
+               + (f"; wrote {out}" if out else ""))
