@@ -1,4 +1,5 @@
-"""``jaxveh simulate``: open-loop manoeuvres of the 14-DOF car (fast or library form)."""
+"""``jaxveh simulate``: manoeuvres of the 14-DOF car (fast or library form), open-loop and
+with the closed-loop driver."""
 
 import math
 import os
@@ -136,7 +137,10 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
     typer.echo(f"{report['title']}: {report['wall_time_s']:.2f} s (compilation included on a first run), "
                f"{report['steps']} steps" + (f"; wrote {out_dir}" if out_dir else ""))
     for key, value in report.items():
-        if key.endswith(("_s", "_pct", "_deg_s", "_g", "_deg", "_per_g")) and key not in ("wall_time_s", "duration_s"):
+        if isinstance(value, bool):
+            typer.echo(f"  {key} = {str(value).lower()}")
+        elif (isinstance(value, float) and key.endswith(("_s", "_pct", "_deg_s", "_g", "_deg", "_per_g", "_m"))
+              and key not in ("wall_time_s", "duration_s")):
             typer.echo(f"  {key} = {value:.4g}")
 
 
@@ -234,20 +238,91 @@ def sine_sweep(
     _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points, figures, param)
 
 
+PreviewOpt = typer.Option(0.8, "--preview-s", help="driver's preview time, s (preview distance = speed x time)")
+LagOpt = typer.Option(0.1, "--lag-s", help="driver's steering lag, s")
+
+
+@app.command("lane-change")
+def lane_change(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    speed_kmh: float = typer.Option(80.0, "--speed-kmh", help="speed held, km/h (ISO 3888-1: 80)"),
+    offset: float = typer.Option(3.5, "--offset", help="lateral offset of the second lane, m (negative: right)"),
+    entry: float = typer.Option(10.0, "--entry", help="run-up before the track, m"),
+    preview_s: float = PreviewOpt, lag_s: float = LagOpt,
+    duration: float = typer.Option(None, "--duration", help="s (default: until 10 m past the track)"),
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
+) -> None:
+    """ISO 3888-1 double lane change with the closed-loop pure-pursuit driver: the car's
+    largest distance from the reference path, its margin to the lanes' cones (lanes_cleared),
+    peak steering, ay and yaw rate; saved at 100 points per second."""
+    from ..manoeuvre import car_width, lane_change as make, lane_change_metrics
+
+    _compilation_cache()
+    try:
+        car = _load(vehicle, 0 if rigid else modes, form, param)
+        m = make(car, speed=_speed(speed_kmh), entry=entry, offset=offset, duration=duration,
+                 preview_time=preview_s, lag=lag_s)
+    except ParameterError as e:
+        fail(str(e))
+    width = car_width(car)
+
+    def metrics(run, car):
+        return {"car_width_m": width} | lane_change_metrics(run.channels, m.steering.path, width)
+
+    points = max(501, math.ceil(100.0 * float(m.duration)) + 1)
+    _run("lane-change", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points,
+         settings=param)
+
+
+def _skid_pad_time_run(vehicle, modes, rigid, form, radius, speed_kmh, duration, turn, preview_s, lag_s, rtol,
+                       out_dir, as_json, quiet, param):
+    """The closed-loop skid-pad: the pure-pursuit driver on the circle for ``duration``."""
+    from ..manoeuvre import constant_radius, constant_radius_metrics
+
+    _compilation_cache()
+    try:
+        car = _load(vehicle, 0 if rigid else modes, form, param)
+        m = constant_radius(car, radius=radius, speed=_speed(speed_kmh), duration=duration, turn=turn,
+                            preview_time=preview_s, lag=lag_s)
+    except ParameterError as e:
+        fail(str(e))
+
+    def metrics(run, car):
+        try:
+            return constant_radius_metrics(run.ts, run.channels, m.steering.path)
+        except ParameterError as e:
+            return {"metrics_error": str(e)}
+
+    _run("skid-pad-time-run", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics,
+         settings=param)
+
+
 @app.command("skid-pad")
 def skid_pad(
     vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
     radius: float = typer.Option(50.0, "--radius", help="circle radius, m (Fig. 7.5: 50)"),
     ay_max_g: float = typer.Option(2.5, "--ay-max-g", help="highest lateral acceleration tried, g"),
     step_g: float = typer.Option(0.05, "--ay-step-g", help="lateral acceleration step, g (also the first point)"),
+    time_run: bool = typer.Option(False, "--time-run", help="closed-loop time run at --speed-kmh instead"),
+    speed_kmh: float = typer.Option(50.0, "--speed-kmh", help="time run: speed held, km/h"),
+    duration: float = typer.Option(30.0, "--duration", help="time run: s"),
+    right: bool = typer.Option(False, "--right", help="time run: turn right"),
+    preview_s: float = PreviewOpt, lag_s: float = LagOpt, rtol: float = RtolOpt,
     out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt, param: list[str] = ParamOpt,
 ) -> None:
     """Skid-pad (Fig. 7.5): the car's steady states on a circle by root finding, from
     --ay-step-g to the grip limit; understeer gradient (deg/g, at the first point), dynamic
-    steer angle, steering sensitivity, sideslip and roll against ay."""
+    steer angle, steering sensitivity, sideslip and roll against ay. With --time-run: the
+    pure-pursuit driver follows the circle from straight running at --speed-kmh for
+    --duration; the settled path radius, steering, ay, sideslip and roll."""
     from .. import plots
     from ..manoeuvre import skid_pad_report
 
+    if time_run:
+        _skid_pad_time_run(vehicle, modes, rigid, form, radius, speed_kmh, duration, -1.0 if right else 1.0,
+                           preview_s, lag_s, rtol, out_dir, as_json, quiet, param)
+        return
     _compilation_cache()
     modes = 0 if rigid else modes
     if form != "fast":

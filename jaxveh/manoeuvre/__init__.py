@@ -1,9 +1,11 @@
 """Manoeuvres on the chapter-6 car: open-loop steering laws with a held speed
-(:mod:`._driver`), integration from straight running in the fast or the library form with
-named channels (:mod:`._simulate`, :mod:`._channels`); steady states (straight running,
-steady cornering, the skid-pad curve) of the fast car by root finding (:mod:`._steady`)."""
+(:mod:`._driver`), the closed-loop pure-pursuit driver on reference paths (:mod:`._pursuit`,
+:mod:`._paths`: skid-pad circle, ISO 3888-1 lane change), integration from straight running
+in the fast or the library form with named channels (:mod:`._simulate`, :mod:`._channels`);
+steady states (straight running, steady cornering, the skid-pad curve) of the fast car by
+root finding (:mod:`._steady`)."""
 
-from ._channels import UNITS as UNITS, car_channels as car_channels
+from ._channels import PATH_CHANNELS as PATH_CHANNELS, UNITS as UNITS, car_channels as car_channels
 from ._driver import (
     AbstractSteeringLaw as AbstractSteeringLaw,
     Manoeuvre as Manoeuvre,
@@ -14,9 +16,25 @@ from ._driver import (
 )
 from ._export import run_dataset as run_dataset, write_netcdf as write_netcdf
 from ._metrics import (
+    constant_radius_metrics as constant_radius_metrics,
     frequency_response as frequency_response,
+    lane_change_metrics as lane_change_metrics,
     ramp_steer_metrics as ramp_steer_metrics,
     step_steer_metrics as step_steer_metrics,
+)
+from ._paths import (
+    ISO_3888_1_SECTIONS as ISO_3888_1_SECTIONS,
+    AbstractPath as AbstractPath,
+    Circle as Circle,
+    DoubleLaneChange as DoubleLaneChange,
+)
+from ._pursuit import (
+    PurePursuit as PurePursuit,
+    car_width as car_width,
+    constant_radius as constant_radius,
+    lane_change as lane_change,
+    pure_pursuit as pure_pursuit,
+    steering_ratio as steering_ratio,
 )
 from ._reports import skid_pad_grid as skid_pad_grid, skid_pad_report as skid_pad_report
 from ._simulate import (

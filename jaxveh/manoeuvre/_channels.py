@@ -13,6 +13,9 @@ from ..vehicle import CORNERS, Car, PushrodSuspension, TyreContact, chassis_twis
 UNITS = {
     "steering_wheel_angle": "deg",
     "speed": "m/s",
+    "x": "m",
+    "y": "m",
+    "heading": "deg",
     "ax": "g",
     "ay": "g",
     "yaw_rate": "deg/s",
@@ -32,6 +35,8 @@ UNITS = {
     "spring_length": "m",
     "spring_force": "N",
 }
+#: The channels of the car's place and heading on the ground (not states of a steady turn).
+PATH_CHANNELS = ("x", "y", "heading")
 
 
 def _aux_slices(elements):
@@ -50,13 +55,15 @@ def car_channels(car: Car, elements: tuple, kin, aux, chassis_velocity, chassis_
     """The channels of :data:`UNITS` at one state. ``chassis_velocity``: the chassis frame's
     body velocities ``(u, omega)`` (m/s, rad/s, chassis axes) and ``chassis_acceleration``
     their time derivatives; ``steering_angle`` in rad. Accelerations and sideslip are those
-    of the sprung mass's c.g. on the undeformed chassis frame."""
+    of the sprung mass's c.g. on the undeformed chassis frame; ``x``, ``y`` its position on
+    the ground (m, from the start) and ``heading`` the chassis x axis's direction (deg)."""
     sys = car.system
     c = sys.body_names.index("chassis")
     r_c, a_c = kin.origins[c], kin.rotations[c]
     v, w = chassis_velocity[:3], chassis_velocity[3:6]
     v_dot, w_dot = chassis_acceleration[:3], chassis_acceleration[3:6]
-    cg = a_c.T @ (kin.x[sys.point_index("chassis.cg")] - r_c)
+    cg_global = kin.x[sys.point_index("chassis.cg")]
+    cg = a_c.T @ (cg_global - r_c)
     v_cg = v + jnp.cross(w, cg)
     a_cg = v_dot + jnp.cross(w, v) + jnp.cross(w_dot, cg) + jnp.cross(w, jnp.cross(w, cg))
     modes = kin.modal[c]
@@ -74,6 +81,9 @@ def car_channels(car: Car, elements: tuple, kin, aux, chassis_velocity, chassis_
     return {
         "steering_wheel_angle": steering_angle * deg,
         "speed": jnp.hypot(v_cg[0], v_cg[1]),
+        "x": cg_global[0],
+        "y": cg_global[1],
+        "heading": jnp.arctan2(a_c[1, 0], a_c[0, 0]) * deg,
         "ax": a_cg[0] / GRAVITY,
         "ay": a_cg[1] / GRAVITY,
         "yaw_rate": w[2] * deg,

@@ -1,6 +1,7 @@
 """Open-loop driver: steering-wheel angle laws (rad, positive to the left) and the
-manoeuvre they make with a held speed (section 6.1.5 "driver model"; the speed is held by
-the powertrain's PID, :class:`jaxveh.vehicle.SpeedPID`).
+manoeuvre they (or the closed-loop driver of :mod:`._pursuit`) make with a held speed
+(section 6.1.5 "driver model"; the speed is held by the powertrain's PID,
+:class:`jaxveh.vehicle.SpeedPID`).
 
 Every law is an Equinox module with float leaves, so a manoeuvre is a pytree: its
 amplitude, timing and speed can be traced, swept with ``vmap`` and differentiated.
@@ -70,10 +71,11 @@ class SweptSine(AbstractSteeringLaw):
 
 
 class Manoeuvre(eqx.Module):
-    """An open-loop manoeuvre from straight running: the ``steering`` law, the ``speed``
-    held (m/s) and the ``duration`` (s)."""
+    """A manoeuvre from straight running: the ``steering`` (an open-loop law of time, or a
+    closed-loop driver such as :class:`jaxveh.manoeuvre.PurePursuit`), the ``speed`` held
+    (m/s) and the ``duration`` (s)."""
 
-    steering: AbstractSteeringLaw
+    steering: eqx.Module
     speed: Float[Array, ""] = checked_field("Manoeuvre.speed", Range(0.0, 100.0, low_open=True, what="speed, m/s"))
     duration: Float[Array, ""] = checked_field("Manoeuvre.duration",
                                                Range(0.0, 600.0, low_open=True, what="duration, s"))

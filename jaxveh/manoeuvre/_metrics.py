@@ -5,6 +5,7 @@ import numpy as np
 from .._core import ParameterError
 from ..analytic._transient import _first_crossing
 from ._driver import StepSteer
+from ._paths import Circle, DoubleLaneChange
 
 
 def step_steer_metrics(ts, channels: dict, steer: StepSteer, settle_window: float = 0.5) -> dict:
@@ -102,3 +103,55 @@ def ramp_steer_metrics(channels: dict, wheelbase: float, ay_range_g=(0.1, 0.3)) 
     }
     out = {key: float(np.polyfit(side * ay[use], side * y[use], 1)[0]) for key, y in series.items()}
     return out | {"gradient_points": int(use.sum())}
+
+
+def lane_change_metrics(channels: dict, path: DoubleLaneChange, car_width: float) -> dict:
+    """ISO 3888-1 lane change: the c.g.'s largest distance from the reference path, the
+    smallest margin (m) between the car and a marked lane's edge over the three lanes
+    (negative: a cone is hit; the car is its c.g.'s lateral place plus and minus half of
+    ``car_width``, its yaw ignored), whether every lane is cleared, and the largest
+    steering-wheel angle, lateral acceleration and yaw rate. Save times must be dense
+    enough to sample each lane (its 15-25 m)."""
+    if not car_width > 0.0:
+        raise ParameterError(f"car_width = {car_width!r} is out of range: allowed > 0 m")
+    x, y = np.asarray(channels["x"]), np.asarray(channels["y"])
+    error = np.asarray(path.lateral_error(np.stack([x, y], axis=-1)))
+    margins = []
+    for x0, x1, centre, width in path.lanes(car_width):
+        inside = (x >= x0) & (x <= x1)
+        if not inside.any():
+            raise ParameterError(f"the run does not reach the lane from x = {x0:g} to {x1:g} m "
+                                 "(too short a duration, or too few save points)")
+        margins.append(float(np.min(0.5 * (width - car_width) - np.abs(y[inside] - centre))))
+    return {
+        "max_path_error_m": float(np.max(np.abs(error))),
+        "lane_margin_m": min(margins),
+        "lanes_cleared": bool(min(margins) >= 0.0),
+        "lane_margins_m": margins,
+        "max_steering_wheel_angle_deg": float(np.max(np.abs(channels["steering_wheel_angle"]))),
+        "max_ay_g": float(np.max(np.abs(channels["ay"]))),
+        "max_yaw_rate_deg_s": float(np.max(np.abs(channels["yaw_rate"]))),
+    }
+
+
+def constant_radius_metrics(ts, channels: dict, path: Circle, settle_window: float = 2.0) -> dict:
+    """Closed-loop skid-pad: over the last ``settle_window`` seconds, the mean path radius of
+    the c.g. (its speed over the yaw rate), steering-wheel angle, lateral acceleration,
+    sideslip and roll, the c.g.'s mean distance from the circle (m, positive inside) and how
+    much the steering still moves (its range, deg: a settled run has next to none)."""
+    ts = np.asarray(ts)
+    if not 0.0 < settle_window < ts[-1] - ts[0]:
+        raise ParameterError(f"settle_window = {settle_window!r} is out of range: allowed (0, {ts[-1] - ts[0]:g}) s")
+    tail = ts >= ts[-1] - settle_window
+    ch = {k: np.asarray(channels[k])[tail] for k in ("speed", "yaw_rate", "steering_wheel_angle", "ay", "sideslip",
+                                                      "roll", "x", "y")}
+    error = np.asarray(path.lateral_error(np.stack([ch["x"], ch["y"]], axis=-1)))
+    return {
+        "path_radius_m": float(np.mean(ch["speed"] / np.radians(np.abs(ch["yaw_rate"])))),
+        "path_offset_m": float(np.mean(error)),
+        "steering_wheel_angle_deg": float(np.mean(ch["steering_wheel_angle"])),
+        "steering_wheel_range_deg": float(np.ptp(ch["steering_wheel_angle"])),
+        "ay_g": float(np.mean(ch["ay"])),
+        "sideslip_deg": float(np.mean(ch["sideslip"])),
+        "roll_deg": float(np.mean(ch["roll"])),
+    }

@@ -11,6 +11,7 @@ reason.
 """
 
 import time
+from collections.abc import Callable
 
 import diffrax
 import equinox as eqx
@@ -38,7 +39,8 @@ from ..vehicle import (
 )
 from ..vehicle._setup import CHASSIS_FORWARD, CHASSIS_LATERAL
 from ._channels import UNITS, car_channels
-from ._driver import Manoeuvre
+from ._driver import AbstractSteeringLaw, Manoeuvre
+from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
 
 #: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; KenCarp4 IMEX with the
@@ -89,15 +91,44 @@ def _solver(name: str):
     raise ParameterError(f"solver = {name!r} is not available: allowed {', '.join(map(repr, SOLVERS))}")
 
 
-def _rack_law(car, manoeuvre: Manoeuvre, trim_rack):
-    return mb.TimeInputs(lambda t: trim_rack + steering_rack(car, manoeuvre.steering(t)))
+class _Driving(eqx.Module):
+    """How a manoeuvre steers: the rack ``law``, the force ``elements`` (the car's, plus the
+    closed-loop driver's), the driver's initial states ``aux0`` and the steering-wheel
+    ``angle(t, aux)`` (rad)."""
+
+    law: mb.AbstractInputs
+    elements: tuple
+    aux0: Array
+    angle: Callable
+
+
+def _check_steering(manoeuvre: Manoeuvre):
+    steering = manoeuvre.steering
+    if not isinstance(steering, (AbstractSteeringLaw, PurePursuit)):
+        raise ParameterError(f"manoeuvre.steering is a {type(steering).__name__}: allowed a steering law "
+                             "(StepSteer, RampSteer, SweptSine) or a PurePursuit driver")
+    return steering
+
+
+def _driving(car, manoeuvre: Manoeuvre, trim_rack, pose: int) -> _Driving:
+    """Open-loop laws steer as functions of time; a :class:`PurePursuit` driver steers
+    from its own state (the chassis's x coordinate at ``q[pose]``)."""
+    elements = car_elements(car, ConstantSpeed(manoeuvre.speed))
+    steering = _check_steering(manoeuvre)
+    if isinstance(steering, AbstractSteeringLaw):
+        law = mb.TimeInputs(lambda t: trim_rack + steering_rack(car, steering(t)))
+        return _Driving(law, elements, jnp.zeros(0), lambda t, aux: steering(t))
+    k = sum(len(e.aux_names) for e in elements)
+    law = driver_inputs(car, steering, pose, k, trim_rack)
+    return _Driving(law, elements + (DriverElement(steering, pose),), jnp.zeros(len(DRIVER_STATES)),
+                    lambda t, aux: aux[k])
 
 
 def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
-    law = _rack_law(car, manoeuvre, trim.rack)
-    s0 = trim.state
+    driving = _driving(car, manoeuvre, trim.rack, 0)
+    law, elements = driving.law, driving.elements
+    s0 = FastState(trim.state.q, trim.state.u, jnp.concatenate([trim.state.aux, driving.aux0]))
     model = fast_model(car)
-    elements = car_elements(car, ConstantSpeed(manoeuvre.speed))
 
     def field(t, s, args):
         d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
@@ -105,7 +136,7 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
 
     def channels(t, s):
         d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
-        out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], manoeuvre.steering(t))
+        out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], driving.angle(t, s.aux))
         return out | {"constraint_residual": d.link_residual}
 
     terms = _imex_terms(field, s0, car.n_modes) if solver == "kencarp4" else diffrax.ODETerm(field)
@@ -121,7 +152,8 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
                        jnp.where(sol.result == diffrax.RESULTS.event_occurred, 1, 2))
     valid = jnp.isfinite(sol.ys.q[:, 0])  # Diffrax fills the save times after a stop with inf
     states = jax.tree.map(lambda x: _hold_after_stop(x, valid), sol.ys)
-    return jax.vmap(channels)(ts, states), dict(sol.stats) | {"event": _event_code(rolled, spun), "valid": valid}, status
+    stats = dict(sol.stats) | {"event": _event_code(rolled, spun), "valid": valid}
+    return jax.vmap(channels)(ts, states), stats, status
 
 
 def _rolled_over(q, u):
@@ -163,17 +195,17 @@ def _imex_terms(field, s0: FastState, n_modes: int):
 
 
 def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
-    law = _rack_law(car, manoeuvre, trim.rack)
-    elements = car_elements(car, ConstantSpeed(manoeuvre.speed))
     c = car.system.body_names.index("chassis")
-    chassis = slice(car.system.q_offsets[c], car.system.q_offsets[c] + 6)
+    q_c = car.system.q_offsets[c]  # the chassis's x, y, z, yaw, pitch, roll
+    chassis = slice(q_c, q_c + 6)
+    driving = _driving(car, manoeuvre, trim.rack, q_c)
+    law, elements = driving.law, driving.elements
 
     def outputs(t, state, dyn):
         out = car_channels(car, elements, dyn.kinematics, state.aux, dyn.y[chassis], dyn.y_dot[chassis],
-                           manoeuvre.steering(t))
+                           driving.angle(t, state.aux))
         return out | {"constraint_residual": jnp.max(jnp.abs(dyn.projection.phi))}
 
-    q_c = car.system.q_offsets[c]  # the chassis's x, y, z, yaw, pitch, roll
 
     def rolled(state):
         return _rolled_over(state.q[q_c:q_c + 6], None)
@@ -181,8 +213,9 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
     def spun(state):  # the independent velocities hold the chassis's body-axis u, v
         return _spun(None, state.z[np.asarray([CHASSIS_FORWARD, CHASSIS_LATERAL])])
 
+    aux0 = jnp.concatenate([trim.aux, driving.aux0])
     sim = mb.simulate(car.system, system_params(car), trim.static.q, trim.z, 0.0, manoeuvre.duration, ts,
-                      inputs=law, elements=elements, aux0=trim.aux, outputs=outputs, solver=_solver(solver),
+                      inputs=law, elements=elements, aux0=aux0, outputs=outputs, solver=_solver(solver),
                       rtol=rtol, atol=atol, dt0=FIRST_STEP, max_steps=max_steps,
                       implicit_modes=solver == "kencarp4", throw=False,
                       events={"rollover": lambda t, st: rolled(st), "spin": lambda t, st: spun(st)})
@@ -254,6 +287,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     atol = rtol * 1e-2 if atol is None else atol
     if not atol > 0.0:
         raise ParameterError(f"atol = {atol!r} is out of range: allowed > 0")
+    _check_steering(manoeuvre)
     ts = save_times(manoeuvre, points)
     check_car(car)  # here, so that the programs need no run-time checks (the disk cache keeps them)
     start = time.perf_counter()

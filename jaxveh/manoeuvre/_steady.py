@@ -44,7 +44,7 @@ from ..vehicle import (
     steering_rack,
 )
 from ..vehicle._corner import WHEEL_CENTRE_HEIGHT
-from ._channels import car_channels
+from ._channels import PATH_CHANNELS, car_channels
 
 #: The conditions a steady state can be asked for (two of them, see the module docs).
 CONDITIONS = ("speed", "radius", "ay", "yaw_rate", "steer")
@@ -114,6 +114,7 @@ def _evaluate(car, model, x, n_aux):
     d = fast_dynamics(car, model, q, u, aux, 0.0, TimeInputs(lambda t: rack + jnp.zeros_like(t)), elements)
     steer = -rack / car.params.rack_ratio
     ch = car_channels(car, elements, d.kinematics, aux, u[:6], jnp.zeros(6, x.dtype), steer)
+    ch = {k: v for k, v in ch.items() if k not in PATH_CHANNELS}  # a steady turn has no place or heading
     cg = car.system.point_index("chassis.cg")
     v_cg = d.kinematics.xd[cg]
     speed_h = jnp.hypot(v_cg[0], v_cg[1])

@@ -39,8 +39,8 @@ from ._fit import (
     write_tyre_csv as write_tyre_csv,
 )
 from ._model import (
-    SUPPORTED_FITTYP as SUPPORTED_FITTYP,
     ASYMMETRIC_COEFFICIENTS as ASYMMETRIC_COEFFICIENTS,
+    SUPPORTED_FITTYP as SUPPORTED_FITTYP,
     MagicFormulaTyre as MagicFormulaTyre,
     coefficient_names as coefficient_names,
     mirror_symmetric as mirror_symmetric,
