@@ -136,7 +136,8 @@ def test_lane_change_metrics_on_a_made_up_run():
 
 # ---- on the rigid car ---------------------------------------------------------------------------
 
-POINTS = 701
+#: Save points of the closed-loop skid-pad: the CLI's default, so that its test reuses the program.
+POINTS = 501
 
 
 def _cli_points(manoeuvre):
@@ -253,3 +254,19 @@ def test_cli_lane_change_json(tmp_path, lane_changes):
         assert key in report
     assert report["lanes_cleared"] is True
     assert (tmp_path / "lane_change.png").exists() and (tmp_path / "lane_change.nc").exists()
+
+
+@pytest.mark.slow
+def test_cli_skid_pad_time_run_json():
+    """``skid-pad --time-run``: the closed-loop run's settled values (the skid-pad test's
+    compiled program serves: same car, driver and save points)."""
+    result = CliRunner().invoke(app, ["simulate", "skid-pad", "--time-run", "--rigid", "--speed-kmh", "45",
+                                      "--duration", "20", "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    assert report["manoeuvre"] == "skid-pad-time-run" and report["stop_reason"] == "completed"
+    v = 45.0 / 3.6
+    np.testing.assert_allclose(report["ay_g"], v * v / report["path_radius_m"] / 9.80665, rtol=2e-3)
+    assert abs(report["path_radius_m"] - 50.0) < 0.5 and report["steering_wheel_range_deg"] < 1e-2
+    bad = CliRunner().invoke(app, ["simulate", "skid-pad", "--time-run", "--rigid", "--radius", "0.5"])
+    assert bad.exit_code != 0 and "Circle.radius" in bad.output
