@@ -100,8 +100,9 @@ def roll_centre_heights(car) -> tuple[Float[Array, ""], Float[Array, ""]]:
         mat = jnp.stack([d1, -d2], axis=1)
         s = jnp.linalg.solve(mat, upper_in - lower_in)[0]
         ic = lower_in + s * d1
-        # contact patch on the road at rest: (y_w, -sink) in the design frame
-        y_w, ground = w[k, 1], -sink
+        # contact patch on the road at rest: the car sits `sink` lower than its design
+        # position, so in the design frame the road is at z = +sink
+        y_w, ground = w[k, 1], sink
         z_rc = ground + (ic[1] - ground) * (0.0 - y_w) / (ic[0] - y_w)
         out.append(z_rc - ground)
     return out[0], out[1]
