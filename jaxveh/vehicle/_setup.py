@@ -10,14 +10,15 @@ are the generalised forces ``R^T T^T (Q_int + Q_ext)`` in those directions at ze
 """
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 from jaxtyping import Array, Float
 
-from .._core import check_range, is_concrete
+from .._core import check_range, is_concrete, run_time_checks_off
 from ..multibody import MultibodyError, dynamics, rotation_matrix
-from ._car import CORNERS, Car, car_elements, design_coordinates, static_corner_loads, system_params
+from ._car import CORNERS, Car, car_elements, check_car, design_coordinates, static_corner_loads, system_params
 from ._corner import WHEEL_CENTRE_HEIGHT
 from ._powertrain import ConstantSpeed
 
@@ -174,8 +175,15 @@ def chassis_twist(car: Car, modes) -> Float[Array, ""]:
 
 def static_equilibrium(car: Car, max_steps: int = 32, throw: bool = True) -> StaticState:
     """The car at rest on a flat road (see module). With ``throw`` a failed solve raises
-    :class:`SetupError` (a run-time error under ``jit``). Differentiable in ``car.params``."""
-    state = _solve(car, max_steps)
+    :class:`SetupError` (a run-time error under ``jit``). Differentiable in ``car.params``.
+    A concrete car is checked here (:func:`check_car`) and solved by a program without
+    run-time checks, which JAX's disk cache keeps."""
+    if all(is_concrete(x) for x in jax.tree.leaves(eqx.filter(car, eqx.is_array))):
+        check_car(car)
+        with run_time_checks_off():
+            state = _solve(car, max_steps)
+    else:
+        state = _solve(car, max_steps)
     if not throw:
         return state
     if is_concrete(state.ok):
