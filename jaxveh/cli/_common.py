@@ -37,3 +37,20 @@ def fail(message: str) -> None:
     """Print an error to stderr and exit with status 2."""
     typer.echo(f"error: {message}", err=True)
     raise typer.Exit(code=2)
+
+
+def write_curve_csv(path: Path, curve: dict) -> None:
+    """A skid-pad curve (name -> values per point; 2-D entries per corner or mode) as CSV."""
+    header, columns = [], []
+    for key, values in curve.items():
+        v = np.asarray(values)
+        if v.ndim == 1:
+            header.append(key)
+            columns.append(v)
+        else:
+            labels = ("fl", "fr", "rl", "rr") if key == "fz_n" else range(1, v.shape[1] + 1)
+            for k, label in enumerate(labels):
+                header.append(key.replace("_n", f"_{label}_n") if key == "fz_n" else f"{key}_{label}")
+                columns.append(v[:, k])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savetxt(path, np.column_stack(columns), delimiter=",", header=",".join(header), comments="")

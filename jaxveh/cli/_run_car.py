@@ -9,27 +9,12 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from ._common import write_json
+from ._common import write_curve_csv, write_json
 
 #: The step steer of Fig. 7.6 on the car: 90 km/h, 6 deg at the steering wheel (about 1.5 deg
 #: at the front wheels) from 0.5 s over 0.2 s, 5 s.
 STEP = {"speed_kmh": 90.0, "steer_deg": 6.0, "duration_s": 5.0}
 CHASSIS = {"rigid": 0, "flexible": 6}
-
-
-def _curve_csv(path: Path, curve: dict) -> None:
-    header, columns = [], []
-    for key, values in curve.items():
-        v = np.asarray(values)
-        if v.ndim == 1:
-            header.append(key)
-            columns.append(v)
-        else:
-            labels = ("fl", "fr", "rl", "rr") if key == "fz_n" else range(1, v.shape[1] + 1)
-            for k, label in enumerate(labels):
-                header.append(key.replace("_n", f"_{label}_n") if key == "fz_n" else f"{key}_{label}")
-                columns.append(v[:, k])
-    np.savetxt(path, np.column_stack(columns), delimiter=",", header=",".join(header), comments="")
 
 
 def _at(curve: dict, key: str, ay_g: float) -> float:
@@ -58,7 +43,7 @@ def car_section(out: Path, car_file: Path | None, say) -> dict:
     for label, car in cars.items():
         pads[label] = skid_pad_report(car, 50.0, 2.5, 0.05)
         write_json(pads[label], out / f"car_skid_pad_{label}.json")
-        _curve_csv(out / f"car_skid_pad_{label}.csv", pads[label]["curve"])
+        write_curve_csv(out / f"car_skid_pad_{label}.csv", pads[label]["curve"])
     plots.save(plots.plot_skid_pad({k: p["curve"] for k, p in pads.items()}, title="skid-pad R = 50 m (car)"),
                out / "car_skid_pad.png")
     summary["skid_pad"] = {label: {

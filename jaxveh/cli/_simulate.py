@@ -10,7 +10,7 @@ import numpy as np
 import typer
 
 from .._core import ParameterError
-from ._common import emit_json, fail, write_json
+from ._common import emit_json, fail, write_curve_csv, write_json
 
 app = typer.Typer(help="Manoeuvres of the 14-DOF car with its flexible chassis.", no_args_is_help=True)
 
@@ -343,19 +343,7 @@ def skid_pad(
         out_dir = Path(out_dir)
         write_json(report, out_dir / "skid_pad.json")
         curve = report["curve"]
-        header, columns = [], []
-        for key, values in curve.items():
-            v = np.asarray(values)
-            if v.ndim == 1:
-                header.append(key)
-                columns.append(v)
-            else:
-                labels = ("fl", "fr", "rl", "rr") if key == "fz_n" else range(1, v.shape[1] + 1)
-                for k, label in enumerate(labels):
-                    header.append(key.replace("_n", f"_{label}_n") if key == "fz_n" else f"{key}_{label}")
-                    columns.append(v[:, k])
-        np.savetxt(out_dir / "skid_pad.csv", np.column_stack(columns), delimiter=",", header=",".join(header),
-                   comments="")
+        write_curve_csv(out_dir / "skid_pad.csv", curve)
         plots.save(plots.plot_skid_pad({chassis: curve}, title=report["title"]), out_dir / "skid_pad.png")
     if as_json:
         emit_json(report)
