@@ -206,7 +206,6 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
                            driving.angle(t, state.aux))
         return out | {"constraint_residual": jnp.max(jnp.abs(dyn.projection.phi))}
 
-
     def rolled(state):
         return _rolled_over(state.q[q_c:q_c + 6], None)
 
