@@ -270,3 +270,22 @@ def test_cli_skid_pad_time_run_json():
     assert abs(report["path_radius_m"] - 50.0) < 0.5 and report["steering_wheel_range_deg"] < 1e-2
     bad = CliRunner().invoke(app, ["simulate", "skid-pad", "--time-run", "--rigid", "--radius", "0.5"])
     assert bad.exit_code != 0 and "Circle.radius" in bad.output
+
+
+@pytest.mark.slow
+def test_library_form_runs_the_same_driver(car, lane_changes):
+    """The first 2.5 s of the lane change (into the first transition) in the library form
+    equal the fast form's on every channel to 1e-5 of its range at rtol 1e-8, as the
+    open-loop runs do (tests/test_manoeuvre.py): the driver reads the chassis pose from either form's
+    coordinates."""
+    m = lane_change(car, duration=2.5)
+    points = _cli_points(lane_change(car))  # the fixture's fast program serves
+    fast = simulate(car, m, points=points, rtol=1e-8)
+    lib = simulate(car, m, points=points, form="library", rtol=1e-8)
+    assert lib.stop_reason == "completed"
+    assert np.max(np.abs(np.asarray(lib.channels["steering_wheel_angle"]))) > 1.0  # the driver steers
+    for name, value in lib.channels.items():
+        if name in ("modes", "constraint_residual"):
+            continue
+        value = np.asarray(value)
+        assert np.max(np.abs(np.asarray(fast.channels[name]) - value)) <= 1e-5 * np.max(np.abs(value)), name
