@@ -14,6 +14,16 @@ from ._chapter3 import (
     static_sink as static_sink,
     with_lambda as with_lambda,
 )
+from ._linear import (
+    DEFAULT_OUTPUTS as DEFAULT_OUTPUTS,
+    INPUTS as INPUTS,
+    CarLinearisation as CarLinearisation,
+    input_direction as input_direction,
+    linearise as linearise,
+    modes as modes,
+    output_index as output_index,
+    transfer_function as transfer_function,
+)
 from ._load_transfer import (
     AY_GRID_G as AY_GRID_G,
     LAMBDA_RANGE as LAMBDA_RANGE,

@@ -139,7 +139,8 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
     for key, value in report.items():
         if isinstance(value, bool):
             typer.echo(f"  {key} = {str(value).lower()}")
-        elif (isinstance(value, float) and key.endswith(("_s", "_pct", "_deg_s", "_g", "_deg", "_per_g", "_m"))
+        elif (isinstance(value, float) and key not in ("wall_time_s", "duration_s", "amplitude_mm")
+              and key.endswith(("_s", "_pct", "_deg_s", "_g", "_deg", "_per_g", "_m", "_hz", "_per_mm"))
               and key not in ("wall_time_s", "duration_s")):
             typer.echo(f"  {key} = {value:.4g}")
 
@@ -236,6 +237,45 @@ def sine_sweep(
 
     points = max(501, math.ceil(10.0 * f_max * duration) + 1)
     _run("sine-sweep", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points, figures, param)
+
+
+@app.command("four-post")
+def four_post(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    pattern: str = typer.Option("warp", "--pattern", help="warp (each axle's wheels in anti-phase, diagonals "
+                                "together) or heave (all posts in phase)"),
+    speed_kmh: float = typer.Option(50.0, "--speed-kmh", help="rolling speed on the posts, km/h"),
+    amplitude_mm: float = typer.Option(0.2, "--amplitude-mm", help="post displacement amplitude, mm (small enough "
+                                       "to keep the tyres on the posts at the warp resonance)"),
+    f_max: float = typer.Option(30.0, "--f-max", help="end frequency of the sweep from 0, Hz (Fig. 7.9: 30)"),
+    duration: float = typer.Option(40.0, "--duration", help="sweep time, s"),
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
+) -> None:
+    """Four-post rig (Fig. 7.9): the car rolls straight on four posts sweeping in sine from 0
+    to --f-max Hz after 0.5 s; RMS contact-patch load variation per tyre, the smallest load,
+    and frequency responses per front-left post displacement of the front-left load, the
+    chassis twist and the modal coordinates (peaks between 0.5 Hz and --f-max), saved at 10
+    points per period of --f-max."""
+    from .. import plots
+    from ..manoeuvre import four_post as make, four_post_metrics
+
+    if not f_max > 0.0:
+        fail(f"--f-max must be > 0 Hz, got {f_max:g}")
+    try:
+        m = make(speed=_speed(speed_kmh), pattern=pattern, amplitude=amplitude_mm * 1e-3, f1=f_max, sweep=duration)
+    except ParameterError as e:
+        fail(str(e))
+
+    def metrics(run, car):
+        return {"pattern": pattern, "amplitude_mm": amplitude_mm} | four_post_metrics(run.ts, run.channels,
+                                                                                     f_range=(0.5, f_max))
+
+    def figures(report):
+        return {"frf": plots.plot_four_post({report["chassis"]: report["frequency_response"]}, title=report["title"])}
+
+    points = max(501, math.ceil(10.0 * f_max * float(m.duration)) + 1)
+    _run("four-post", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points, figures, param)
 
 
 PreviewOpt = typer.Option(0.8, "--preview-s", help="driver's preview time, s (preview distance = speed x time)")

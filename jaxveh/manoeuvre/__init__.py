@@ -1,6 +1,7 @@
 """Manoeuvres on the chapter-6 car: open-loop steering laws with a held speed
-(:mod:`._driver`), the closed-loop pure-pursuit driver on reference paths (:mod:`._pursuit`,
-:mod:`._paths`: skid-pad circle, ISO 3888-1 lane change), integration from straight running
+(:mod:`._driver`), the four-post rig's road input (:mod:`._road`), the closed-loop
+pure-pursuit driver on reference paths (:mod:`._pursuit`, :mod:`._paths`: skid-pad circle,
+ISO 3888-1 lane change), integration from straight running
 in the fast or the library form with named channels (:mod:`._simulate`, :mod:`._channels`);
 steady states (straight running, steady cornering, the skid-pad curve) of the fast car by
 root finding (:mod:`._steady`)."""
@@ -17,6 +18,7 @@ from ._driver import (
 from ._export import run_dataset as run_dataset, write_netcdf as write_netcdf
 from ._metrics import (
     constant_radius_metrics as constant_radius_metrics,
+    four_post_metrics as four_post_metrics,
     frequency_response as frequency_response,
     lane_change_metrics as lane_change_metrics,
     ramp_steer_metrics as ramp_steer_metrics,
@@ -37,6 +39,12 @@ from ._pursuit import (
     steering_ratio as steering_ratio,
 )
 from ._reports import skid_pad_grid as skid_pad_grid, skid_pad_report as skid_pad_report
+from ._road import (
+    POST_PATTERNS as POST_PATTERNS,
+    PostSweep as PostSweep,
+    Straight as Straight,
+    four_post as four_post,
+)
 from ._simulate import (
     EVENTS as EVENTS,
     SOLVERS as SOLVERS,

@@ -14,6 +14,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from ..params import Range, checked_field
+from ..vehicle import AbstractRoad, FlatRoad
 
 _ANGLE = Range(-3.0, 3.0, what="steering-wheel angle, rad")
 _TIME = Range(0.0, what="time, s")
@@ -65,20 +66,28 @@ class SweptSine(AbstractSteeringLaw):
     start: Float[Array, ""] = checked_field("SweptSine.start", _TIME)
 
     def __call__(self, t):
-        s = jnp.clip(t - self.start, 0.0, self.sweep)
-        phase = 2.0 * jnp.pi * (self.f0 * s + 0.5 * (self.f1 - self.f0) * s * s / self.sweep)
-        return self.amplitude * jnp.sin(phase)
+        return self.amplitude * jnp.sin(sweep_phase(t, self.f0, self.f1, self.sweep, self.start))
+
+
+def sweep_phase(t, f0, f1, sweep, start):
+    """Phase (rad) at ``t`` (s) of a linear sweep from ``f0`` to ``f1`` (Hz) over ``sweep``
+    seconds after ``start``: zero before ``start``, constant after the sweep."""
+    s = jnp.clip(t - start, 0.0, sweep)
+    return 2.0 * jnp.pi * (f0 * s + 0.5 * (f1 - f0) * s * s / sweep)
 
 
 class Manoeuvre(eqx.Module):
     """A manoeuvre from straight running: the ``steering`` (an open-loop law of time, or a
     closed-loop driver such as :class:`jaxveh.manoeuvre.PurePursuit`), the ``speed`` held
-    (m/s) and the ``duration`` (s)."""
+    (m/s), the ``duration`` (s) and the ``road`` (flat by default; a
+    :class:`jaxveh.manoeuvre.PostSweep` for the four-post rig; its height at the start must
+    be zero: the run starts from straight running on a flat road)."""
 
     steering: eqx.Module
     speed: Float[Array, ""] = checked_field("Manoeuvre.speed", Range(0.0, 100.0, low_open=True, what="speed, m/s"))
     duration: Float[Array, ""] = checked_field("Manoeuvre.duration",
                                                Range(0.0, 600.0, low_open=True, what="duration, s"))
+    road: AbstractRoad = FlatRoad()
 
 
 def step_steer(speed: float = 25.0, angle: float = 0.1, start: float = 0.5, rise: float = 0.2,

@@ -34,15 +34,19 @@ def step_steer_metrics(ts, channels: dict, steer: StepSteer, settle_window: floa
 
 
 def frequency_response(ts, channels: dict, outputs=("yaw_rate", "ay"), f_max: float | None = None,
-                       window_sigma: float = 0.5) -> dict:
+                       window_sigma: float = 0.5, input: str = "steering_wheel_angle") -> dict:
     """Frequency responses of a swept-sine run by FFT (section 6.4.3, Fig. 6.15): each output
     channel and the steering-wheel angle, less their values at the start (straight running),
     times one Gaussian window centred on the record (standard deviation ``window_sigma`` of
     the half record: the thesis's 0.5), give ``H(f) = Y(f) / U(f)`` at the FFT frequencies
     ``k / T`` from the first non-zero one up to ``f_max`` (Hz; default the Nyquist frequency).
 
-    Returns ``frequency_hz`` and per output ``{name}_gain`` (channel units per degree of
-    steering-wheel angle: deg/s/deg for the yaw rate, g/deg for ay), ``{name}_gain_db``
+    ``input``: the channel taken as the input (default the steering-wheel angle; the
+    four-post rig uses a post's height). Every channel named must hold one value per save
+    time.
+
+    Returns ``frequency_hz`` and per output ``{name}_gain`` (channel units per unit of the
+    input: deg/s/deg for the yaw rate per steering-wheel degree, g/deg for ay), ``{name}_gain_db``
     (20 log10 of it) and ``{name}_phase_deg`` (unwrapped from the lowest frequency, so a
     turn in the steered direction starts near 0). ``ts`` must be evenly spaced (s)."""
     ts = np.asarray(ts, float)
@@ -57,7 +61,9 @@ def frequency_response(ts, channels: dict, outputs=("yaw_rate", "ay"), f_max: fl
         raise ParameterError(f"f_max = {f_max!r} is out of range: allowed (0, {nyquist:g}] Hz (the Nyquist frequency)")
     half = 0.5 * (ts[-1] - ts[0])
     window = np.exp(-0.5 * ((ts - ts[0] - half) / (window_sigma * half)) ** 2)
-    u = np.asarray(channels["steering_wheel_angle"], float)
+    if input not in channels or np.ndim(channels[input]) != 1:
+        raise ParameterError(f"input {input!r} must be a scalar channel of the run (one value per save time)")
+    u = np.asarray(channels[input], float)
     spectrum = np.fft.rfft(window * (u - u[0]))
     freq = np.fft.rfftfreq(ts.size, dt[0])
     keep = (freq > 0.0) & (freq <= f_max * (1.0 + 1e-12))
@@ -155,3 +161,50 @@ def constant_radius_metrics(ts, channels: dict, path: Circle, settle_window: flo
         "sideslip_deg": float(np.mean(ch["sideslip"])),
         "roll_deg": float(np.mean(ch["roll"])),
     }
+
+
+def four_post_metrics(ts, channels: dict, f_range=(0.5, 30.0), window_sigma: float = 0.5) -> dict:
+    """Metrics of a four-post sweep (:func:`jaxveh.manoeuvre.four_post`, Fig. 7.9): the RMS
+    contact-patch load variation of each tyre about its value at the start (N and % of it;
+    FL, FR, RL, RR), the smallest load (N; ``wheel_lift`` when a tyre leaves the post), and
+    the frequency responses per front-left post displacement (:func:`frequency_response`,
+    input the front-left ``road_height``) of the front-left load (N/mm), the chassis twist
+    (deg/mm) and each modal coordinate (1/mm), with the frequency and value of each peak in
+    ``f_range`` (Hz; twist and modes only on a flexible chassis: None and empty lists on a
+    rigid one). The responses' ``frequency_hz`` and gains are returned under
+    ``frequency_response`` (gains per mm)."""
+    fz = np.asarray(channels["fz"], float)
+    static = fz[0]
+    rms = np.sqrt(np.mean((fz - static) ** 2, axis=0))
+    scalar = {"road": np.asarray(channels["road_height"], float)[:, 0] * 1e3, "fz_front_left": fz[:, 0]}
+    modes = np.asarray(channels["modes"], float)
+    flexible = modes.shape[1] > 0
+    if flexible:  # a rigid chassis has no twist and no modal coordinates
+        scalar["twist"] = np.asarray(channels["twist"], float)
+        scalar |= {f"mode_{k + 1}": modes[:, k] for k in range(modes.shape[1])}
+    outputs = tuple(k for k in scalar if k != "road")
+    frf = frequency_response(ts, scalar, outputs=outputs, f_max=f_range[1], window_sigma=window_sigma, input="road")
+    f = frf["frequency_hz"]
+    band = f >= f_range[0]
+    if not np.any(band):
+        raise ParameterError(f"f_range = {f_range!r} holds no frequency of the run's FFT (resolution {f[0]:g} Hz)")
+
+    def peak(name):
+        g = np.where(band, frf[f"{name}_gain"], -np.inf)
+        k = int(np.argmax(g))
+        return float(f[k]), float(g[k])
+
+    out = {
+        "rms_fz_variation_n": rms.tolist(),
+        "rms_fz_variation_pct": (100.0 * rms / static).tolist(),
+        "min_fz_n": fz.min(axis=0).tolist(),
+        "wheel_lift": bool(np.any(fz <= 0.0)),
+    }
+    out["fz_front_left_peak_hz"], out["fz_front_left_peak_n_per_mm"] = peak("fz_front_left")
+    out["twist_peak_hz"], out["twist_peak_deg_per_mm"] = peak("twist") if flexible else (None, None)
+    peaks = [peak(f"mode_{k + 1}") for k in range(modes.shape[1])]
+    out["modes_peak_hz"] = [p[0] for p in peaks]
+    out["modes_peak_per_mm"] = [p[1] for p in peaks]
+    out["frequency_response"] = {"frequency_hz": f.tolist()} | {
+        f"{name}_gain": frf[f"{name}_gain"].tolist() for name in outputs}
+    return out

@@ -113,7 +113,7 @@ def _check_steering(manoeuvre: Manoeuvre):
 def _driving(car, manoeuvre: Manoeuvre, trim_rack, pose: int) -> _Driving:
     """Open-loop laws steer as functions of time; a :class:`PurePursuit` driver steers
     from its own state (the chassis's x coordinate at ``q[pose]``)."""
-    elements = car_elements(car, ConstantSpeed(manoeuvre.speed))
+    elements = car_elements(car, ConstantSpeed(manoeuvre.speed), road=manoeuvre.road)
     steering = _check_steering(manoeuvre)
     if isinstance(steering, AbstractSteeringLaw):
         law = mb.TimeInputs(lambda t: trim_rack + steering_rack(car, steering(t)))

@@ -12,6 +12,7 @@ from ._chapter3 import (
     save as save,
 )
 from ._manoeuvres import (
+    plot_four_post as plot_four_post,
     plot_frequency_response as plot_frequency_response,
     plot_manoeuvre as plot_manoeuvre,
     plot_skid_pad as plot_skid_pad,

@@ -91,3 +91,32 @@ def plot_frequency_response(responses: dict, title: str = ""):
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+def plot_four_post(responses: dict, title: str = ""):
+    """Four-post frequency responses per front-left post displacement (Fig. 7.9 (c), (d)):
+    the front-left contact-patch load (N/mm) and the chassis twist (deg/mm) of one or more
+    runs (``{label: response}``, the ``frequency_response`` of
+    :func:`jaxveh.manoeuvre.four_post_metrics`), and each modal coordinate (1/mm) of the
+    first run, on log-log axes."""
+    fig, axes = figure(1, 3, figsize=(14, 4.2))
+    styles = ("-", "--", "-.", ":")
+    for (label, r), style in zip(responses.items(), styles):
+        f = np.asarray(r["frequency_hz"])
+        axes[0].loglog(f, r["fz_front_left_gain"], style, label=label)
+        if "twist_gain" in r:  # flexible chassis only
+            axes[1].loglog(f, r["twist_gain"], style, label=label)
+    first = next(iter(responses.values()))
+    modes = sorted(k for k in first if k.startswith("mode_") and k.endswith("_gain"))
+    for name in modes:
+        axes[2].loglog(first["frequency_hz"], first[name], label=name.removesuffix("_gain").replace("_", " "))
+    for ax, label in zip(axes, ("front-left load [N/mm]", "chassis twist [deg/mm]", "modal coordinates [1/mm]"),
+                         strict=True):
+        ax.set_xlabel("f [Hz]")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig

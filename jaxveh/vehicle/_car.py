@@ -36,8 +36,8 @@ from jaxtyping import Array, Float
 from .. import fe
 from .._core import GRAVITY, ParameterError, as_float, check_range
 from ..multibody import FlexibleBody, RigidBody, System, SystemBuilder, SystemParams, TimeInputs
-from ..params import HARD_POINT_NAMES, CarFile, VehicleData, hard_points_vehicle_frame, read_car_file, set_all
 from ..multibody._system import checked_params
+from ..params import HARD_POINT_NAMES, CarFile, VehicleData, hard_points_vehicle_frame, read_car_file, set_all
 from ..tyre import check_tyre, fsae_tir_path, read_tir, stack_tyres
 from ._aero import AeroLoads, AeroMap, aero_map_from_coefficients
 from ._contact import AbstractRoad, FlatRoad, TyreContact
