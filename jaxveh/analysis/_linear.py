@@ -100,9 +100,12 @@ def _check_outputs(channels):
     return tuple(channels)
 
 
-def _jacobians(car, trim, speed, channels):
-    """``(a, b, c, d, x0, x_dot0)`` about the straight-running ``trim`` (a
-    :class:`jaxveh.manoeuvre.SteadyCornering`) at ``speed`` (m/s)."""
+def linear_field(car, trim, speed, channels):
+    """``(field, x0)``: ``field(x, w) -> (x_dot, y)``, the fast car's vector field and the
+    ``channels`` at the flat state ``x`` and inputs ``w`` (15: the 5 inputs of
+    :data:`INPUTS`, then their first and second derivatives), about the straight-running
+    ``trim`` (a :class:`jaxveh.manoeuvre.SteadyCornering`) at ``speed`` (m/s); ``x0`` the
+    trim's flat state."""
     model = fast_model(car)
     x0, unravel = jax.flatten_util.ravel_pytree(trim.state)
 
@@ -119,6 +122,12 @@ def _jacobians(car, trim, speed, channels):
         y = jnp.concatenate([jnp.ravel(ch[name]) for name in channels])
         return x_dot, y
 
+    return field, x0
+
+
+def _jacobians(car, trim, speed, channels):
+    """``(a, b, c, d, x0, x_dot0)`` about the straight-running ``trim`` at ``speed`` (m/s)."""
+    field, x0 = linear_field(car, trim, speed, channels)
     w0 = jnp.zeros(15)
     x_dot0 = field(x0, w0)[0]
     (a, c) = jax.jacfwd(field, argnums=0)(x0, w0)
