@@ -43,3 +43,12 @@ from ._load_transfer import (
     mode_stiffness_designs as mode_stiffness_designs,
 )
 from ._reports import lltd_report as lltd_report
+from ._root_locus import (
+    SWEEPS as SWEEPS,
+    RootLocus as RootLocus,
+    first_chassis_mode as first_chassis_mode,
+    kinetic_energy_shares as kinetic_energy_shares,
+    mode_label as mode_label,
+    root_locus as root_locus,
+    root_locus_report as root_locus_report,
+)

@@ -176,3 +176,45 @@ def lltd(vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidO
                f"{report['chi_eq_3_5_flexible']:.4f}; eq. 3.6 (mean track) rigid "
                f"{report['chi_eq_3_6_rigid_mean_track']:.4f}, flexible {report['chi_eq_3_6_flexible_mean_track']:.4f}"
                + (f"; wrote {out}" if out else ""))
+
+
+@vehicle_app.command("root-locus")
+def root_locus(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
+               sweep: str = typer.Option("coupling", "--sweep", help="coupling (0 to 1), speed (5 to 120 km/h) or "
+                                         "first-mode (first chassis mode's free-free frequency, 12 to 120 Hz)"),
+               speed_kmh: float = typer.Option(50.0, "--speed-kmh", help="speed of the straight running linearised "
+                                               "about, km/h (not for --sweep speed)"),
+               as_json: bool = JsonOpt, out: Path = OutOpt) -> None:
+    """Root locus of the linearised car (Fig. 7.7): eigenvalues along a sweep, each mode
+    tracked by MAC and labelled by where its kinetic energy sits; for the coupling sweep the
+    first chassis mode's uncoupled and coupled frequencies."""
+    from ..analysis import root_locus_report
+    from ._simulate import _compilation_cache
+
+    _compilation_cache()
+    if not speed_kmh > 0.0:
+        fail(f"--speed-kmh must be > 0, got {speed_kmh:g}")
+    try:
+        report = root_locus_report(_car(vehicle, modes), sweep, speed=speed_kmh / 3.6)
+    except (*_errors(), RuntimeError) as e:
+        fail(str(e))
+    if out is not None:
+        from .. import plots
+
+        out = Path(out)
+        write_json(report, out / "root_locus.json")
+        loci = {f"{k + 1}: {m['label']}": (np.asarray(m["real_per_s"]) + 2j * np.pi * np.asarray(m["frequency_hz"]))
+                [:, None] for k, m in enumerate(report["modes"])}
+        plots.save(plots.plot_root_locus(loci, title=f"root locus, {sweep} sweep (Fig. 7.7)"), out / "root_locus.png")
+    if as_json:
+        emit_json(report)
+        return
+    typer.echo(f"root locus, {sweep} sweep over {report['values'][0]:g}-{report['values'][-1]:g} {report['unit']} "
+               f"({len(report['values'])} points)" + (f"; wrote {out}" if out else ""))
+    for m in report["modes"]:
+        f, z = m["frequency_hz"], m["damping_ratio"]
+        typer.echo(f"  {m['label']:>22}: {f[0]:7.2f} -> {f[-1]:7.2f} Hz, damping {z[0]:.3f} -> {z[-1]:.3f}")
+    if "first_chassis_mode_hz" in report:
+        c = report["first_chassis_mode_hz"]
+        typer.echo(f"first chassis mode: {c['uncoupled']:.2f} Hz uncoupled -> {c['coupled']:.2f} Hz coupled "
+                   f"({c['label']})")
