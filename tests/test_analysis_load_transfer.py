@@ -303,3 +303,42 @@ def test_cli_lltd_bad_radius():
     result = runner.invoke(app, ["vehicle", "lltd", "--rigid", "--radius", "-5"])
     assert result.exit_code == 2
     assert "radius = -5.0 is out of range: allowed > 0 (m)" in result.output
+
+
+# ---- χ against the number of modes (one vmapped call) ------------------------------------------
+
+
+def test_modal_truncation_keeps_the_first_modes():
+    """What `chi_by_modes` relies on: the first k modes of a larger car are the k-mode car's
+    (shapes at every point, stiffness, damping)."""
+    one, three = load_car(modes=1).params.chassis, load_car(modes=3).params.chassis
+    np.testing.assert_array_equal(np.asarray(three.point_phi_translation)[..., :1], one.point_phi_translation)
+    np.testing.assert_array_equal(np.asarray(three.point_phi_rotation)[..., :1], one.point_phi_rotation)
+    np.testing.assert_array_equal(np.asarray(three.frequencies_hz)[:1], one.frequencies_hz)
+    np.testing.assert_array_equal(np.asarray(three.damping_ratios())[:1], one.damping_ratios())
+
+
+@pytest.fixture(scope="module")
+def chi_by_modes():
+    return np.asarray(an.chi_by_modes(2))
+
+
+@pytest.mark.slow
+def test_chi_by_modes_ends_at_the_rigid_and_the_full_car(chi_by_modes, rigid_lt, flex_batch):
+    """Entry 0 (every mode frozen) is the rigid car's χ and entry 2 the 2-mode car's, to 1e-7."""
+    assert chi_by_modes.shape == (3,)
+    np.testing.assert_allclose(chi_by_modes[0], float(rigid_lt.chi_low_ay), atol=1e-7)
+    np.testing.assert_allclose(chi_by_modes[2], float(flex_batch.chi_low_ay[0]), atol=1e-7)
+    assert abs(chi_by_modes[1] - chi_by_modes[0]) > 1e-3  # the first (torsion) mode carries the effect
+
+
+def test_cli_lltd_modes_json(chi_by_modes, rigid):
+    result = runner.invoke(app, ["vehicle", "lltd-modes", "--max-modes", "2", "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    np.testing.assert_allclose(report["chi_by_modes"], chi_by_modes, atol=1e-12)
+    expected = an.chapter3_parameters(rigid)
+    assert report["lam"] == pytest.approx(float(expected.lam))
+    assert 0.3 < report["chi_eq36"] < 0.7
+    bad = runner.invoke(app, ["vehicle", "lltd-modes", "--max-modes", "0"])
+    assert bad.exit_code != 0 and "max_modes = 0" in bad.output

@@ -33,6 +33,7 @@ from ._load_transfer import (
     SKID_PAD_RADIUS as SKID_PAD_RADIUS,
     LoadTransfer as LoadTransfer,
     arb_rates_for_distribution as arb_rates_for_distribution,
+    chi_by_modes as chi_by_modes,
     chi_mode_stiffness_gradient as chi_mode_stiffness_gradient,
     chi_vs_lambda as chi_vs_lambda,
     chi_vs_mode_stiffness as chi_vs_mode_stiffness,
@@ -41,6 +42,7 @@ from ._load_transfer import (
     load_transfer as load_transfer,
     load_transfer_batch as load_transfer_batch,
     mode_stiffness_designs as mode_stiffness_designs,
+    truncation_designs as truncation_designs,
 )
 from ._reports import lltd_report as lltd_report
 from ._root_locus import (

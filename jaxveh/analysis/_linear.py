@@ -24,7 +24,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .._core import ParameterError, run_time_checks_off
-from ..manoeuvre import car_channels, straight_trim
+from ..manoeuvre import PATH_CHANNELS, UNITS, car_channels, straight_trim
 from ..manoeuvre._road import POST_PATTERNS
 from ..manoeuvre._simulate import _compiled_trim
 from ..multibody import TimeInputs
@@ -91,8 +91,6 @@ def output_names(car, channels=DEFAULT_OUTPUTS) -> tuple[str, ...]:
 
 
 def _check_outputs(channels):
-    from ..manoeuvre import PATH_CHANNELS, UNITS
-
     bad = [c for c in channels if c not in UNITS or c in PATH_CHANNELS or c == "steering_wheel_angle"]
     if bad or not channels:
         allowed = [c for c in UNITS if c not in PATH_CHANNELS and c != "steering_wheel_angle"]

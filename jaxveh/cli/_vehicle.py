@@ -218,3 +218,34 @@ def root_locus(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
         c = report["first_chassis_mode_hz"]
         typer.echo(f"first chassis mode: {c['uncoupled']:.2f} Hz uncoupled -> {c['coupled']:.2f} Hz coupled "
                    f"({c['label']})")
+
+
+@vehicle_app.command("lltd-modes")
+def lltd_modes(vehicle: Path = VehicleOpt,
+               max_modes: int = typer.Option(10, "--max-modes", help="largest number of chassis modes, 1 to 20"),
+               radius: float = typer.Option(50.0, "--radius", help="skid-pad radius (m)"),
+               as_json: bool = JsonOpt) -> None:
+    """χ (front share of the lateral load transfer at low ay on the skid-pad) against the
+    number of chassis modes 0 ... --max-modes (Fig. 7.2c; thesis: χ = 0.441 with six modes
+    against eq. 3.6's 0.445), beside eq. 3.6 with the car's own stiffnesses and geometry."""
+    from .. import analytic
+    from ..analysis import analytic_vehicle, chapter3_parameters, chi_by_modes
+    from ._simulate import _compilation_cache
+
+    _compilation_cache()
+    start = time.perf_counter()
+    try:
+        chi = chi_by_modes(max_modes, vehicle, radius)
+        p = chapter3_parameters(_car(vehicle, 6))
+    except _errors() as e:
+        fail(str(e))
+    report = {"modes": list(range(max_modes + 1)), "chi_by_modes": [float(x) for x in np.asarray(chi)],
+              "chi_eq36": float(analytic.chi(analytic_vehicle(p))), "lam": float(p.lam), "radius_m": radius,
+              "wall_time_s": time.perf_counter() - start}
+    if as_json:
+        emit_json(report)
+        return
+    typer.echo(f"chi vs number of chassis modes (lambda {report['lam']:.3f}, R = {radius:g} m; eq. 3.6: "
+               f"{report['chi_eq36']:.4f}):")
+    for n, c in zip(report["modes"], report["chi_by_modes"], strict=True):
+        typer.echo(f"  {n:2d} modes: {c:.4f}")
