@@ -1,9 +1,10 @@
 """The four-post rig (Fig. 7.9) and the exact linearisation of the fast car: the post law,
-the metrics on a made-up linear response, the linearisation against finite differences and
-the car's symmetry, the time run's frequency responses against the linearisation's exact
-transfer functions (peaks within one FFT bin), and the thesis's findings: heave leaves the
-contact-patch load as on a rigid chassis, warp raises its peak and excites the chassis
-modes."""
+the metrics on a made-up linear response, the linearisation against finite differences,
+the time run's frequency responses against the linearisation's exact transfer functions
+(peaks within one FFT bin), and the thesis's findings: heave leaves the contact-patch load
+as on a rigid chassis, warp raises its peak and excites the chassis modes; root loci along
+the coupling and speed sweeps (mode tracking, the uncoupled chassis modes, bad input, the
+CLI). One module, so the 6-mode car's linearisation compiles once."""
 
 import json
 
@@ -21,7 +22,6 @@ from jaxveh.analysis._linear import linear_field
 from jaxveh.cli import app
 from jaxveh.manoeuvre import POST_PATTERNS, PostSweep, four_post, four_post_metrics, simulate
 from jaxveh.manoeuvre._simulate import _compiled_trim
-from jaxveh.tyre import mirror_symmetric
 from jaxveh.vehicle import load_car
 
 SPEED = 50.0 / 3.6
@@ -125,26 +125,6 @@ def test_linearisation_equals_finite_differences(car, lin):
     np.testing.assert_allclose(lam, exact, rtol=1e-6)
 
 
-def test_straight_running_linear_model_is_decoupled_for_a_symmetric_car():
-    """On the rigid car with mirror-symmetric tyres, heave (symmetric) moves no lateral
-    channel and steering (antisymmetric) no symmetric one (the axle's summed loads)."""
-    car = load_car(modes=0)
-    car = eqx.tree_at(lambda c: c.params.tyres, car, mirror_symmetric(car.params.tyres))
-    lin = analysis.linearise(car, SPEED, outputs=("yaw_rate", "ay", "roll", "sideslip", "fz", "travel"))
-    f = np.asarray([0.5, 2.0, 8.0, 17.0])
-    heave = analysis.transfer_function(lin, f, "heave")
-    steer = analysis.transfer_function(lin, f, "steering")
-    lateral = [analysis.output_index(lin, n) for n in ("yaw_rate", "ay", "roll", "sideslip")]
-    scale_heave = np.abs(heave[:, analysis.output_index(lin, "fz.front_left")]).max()
-    assert np.abs(heave[:, lateral]).max() <= 1e-9 * np.abs(steer[:, lateral]).max()
-    for axle in ("front", "rear"):
-        total = sum(steer[:, analysis.output_index(lin, f"fz.{axle}_{side}")] for side in ("left", "right"))
-        assert np.abs(total).max() <= 1e-9 * scale_heave, axle
-    left, right = (analysis.output_index(lin, f"fz.front_{s}") for s in ("left", "right"))
-    np.testing.assert_allclose(heave[:, left], heave[:, right], rtol=1e-9)
-    assert np.abs(steer[:, left]).max() > 1e-3 * scale_heave  # steering does move the loads, left against right
-
-
 def test_thesis_findings_heave_is_rigid_warp_is_not(car, lin):
     """Section 7.4.2 on the linearised car: under heave the front-left load responds as on
     a stiff chassis (within 5 %; measured 3.8 %) and the modal coordinates barely move;
@@ -209,3 +189,73 @@ def test_cli_four_post_json(warp_run):
     assert 15.0 < report["fz_front_left_peak_hz"] < 20.0
     bad = CliRunner().invoke(app, ["simulate", "four-post", "--pattern", "bounce", "--json"])
     assert bad.exit_code != 0 and "pattern = 'bounce'" in bad.output
+
+
+# ---- root loci (Fig. 7.7): the same compiled linearisation at every point ---------------------
+
+@pytest.fixture(scope="module")
+def coupling(car):
+    return analysis.root_locus(car, "coupling")
+
+
+def test_tracked_modes_are_continuous(coupling):
+    """Every mode's worst MAC between neighbouring points is at least 0.8 (the tracker
+    halves an interval until it reaches 0.9), and each locus moves by small steps."""
+    assert np.all(coupling.min_mac >= 0.8)
+    assert coupling.values[0] == 0.0 and coupling.values[-1] == 1.0 and len(coupling.values) >= 11
+    steps = np.abs(np.diff(coupling.eigenvalues, axis=0))
+    assert np.max(steps) < 0.25 * np.max(np.abs(coupling.eigenvalues))
+
+
+def test_uncoupled_chassis_modes_are_the_free_free_modes(car, coupling):
+    """With coupling 0 the chassis modes leave the suspension: each free-free mode appears
+    with its own natural frequency and its modal damping ratio (2.5 %)."""
+    lam0 = coupling.eigenvalues[0]
+    natural = np.abs(lam0) / (2.0 * np.pi)
+    for f, zeta in zip(np.asarray(car.params.chassis.frequencies_hz), np.asarray(car.params.chassis.damping_ratios()),
+                       strict=True):
+        k = int(np.argmin(np.abs(natural - f)))
+        np.testing.assert_allclose(natural[k], f, rtol=1e-4)
+        np.testing.assert_allclose(coupling.damping_ratio[0, k], zeta, rtol=1e-3)
+
+
+def test_first_chassis_mode_drops_when_coupled(car, coupling):
+    j = analysis.first_chassis_mode(coupling, car)
+    f0, f1 = coupling.frequency_hz[0, j], coupling.frequency_hz[-1, j]
+    np.testing.assert_allclose(f0, float(car.params.chassis.frequencies_hz[0]) * np.sqrt(1 - 0.025**2), rtol=1e-4)
+    assert f1 < 0.8 * f0  # the suspension's compliance lowers it (thesis: 38 -> about 17 Hz)
+
+
+def test_bad_sweeps_are_refused_by_name(car):
+    with pytest.raises(ParameterError, match="sweep = 'mass'"):
+        analysis.root_locus(car, "mass")
+    with pytest.raises(ParameterError, match="no chassis modes"):
+        analysis.root_locus(load_car(modes=0), "coupling")
+    with pytest.raises(ParameterError, match="out of range"):
+        analysis.root_locus(car, "coupling", values=[0.0, 2.0])
+    with pytest.raises(ParameterError, match="increasing"):
+        analysis.root_locus(car, "speed", values=[50.0, 40.0])
+
+
+def test_cli_root_locus_coupling_json(coupling):
+    result = CliRunner().invoke(app, ["vehicle", "root-locus", "--sweep", "coupling", "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.stdout)
+    c = report["first_chassis_mode_hz"]
+    assert set(c) >= {"uncoupled", "coupled"}
+    assert c["coupled"] < c["uncoupled"]
+    assert report["sweep"] == "coupling" and report["speed_kmh"] == pytest.approx(50.0)
+    assert all(m["min_neighbour_mac"] >= 0.8 for m in report["modes"])
+
+
+@pytest.mark.slow
+def test_cli_root_locus_speed_json():
+    """The speed sweep re-trims at every speed: the yaw/sideslip modes move with speed."""
+    result = CliRunner().invoke(app, ["vehicle", "root-locus", "--sweep", "speed", "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.stdout)
+    assert report["values"][0] == 5.0 and report["values"][-1] == 120.0 and report["speed_kmh"] is None
+    lateral = [m for m in report["modes"] if m["label"].startswith("yaw/sideslip")]
+    assert lateral and all(m["min_neighbour_mac"] >= 0.8 for m in report["modes"])
+    spread = max(np.ptp(m["real_per_s"]) for m in lateral)
+    assert spread > 1.0  # 1/s: the handling modes depend on speed

@@ -1,16 +1,21 @@
 """Frequency responses by FFT of a swept sine (section 6.4.3, Fig. 6.15): the estimator
-against a closed-form system, and the car's low-frequency gains against its steady state."""
+against a closed-form system, the car's low-frequency gains against its steady state, and
+the rigid car's exact linearisation (transfer functions against the sweep, the symmetric
+car's lateral/vertical decoupling)."""
 
 import json
 
+import equinox as eqx
 import numpy as np
 import pytest
 import scipy.signal as sg
 from typer.testing import CliRunner
 
+from jaxveh import analysis
 from jaxveh._core import ParameterError
 from jaxveh.cli import app
 from jaxveh.manoeuvre import Manoeuvre, SweptSine, frequency_response, simulate, steady_state
+from jaxveh.tyre import mirror_symmetric
 from jaxveh.vehicle import load_car
 
 # The car's sweep: 50 km/h (Fig. 6.15), 1 deg at the steering wheel (linear range), 0-2 Hz
@@ -107,11 +112,9 @@ def test_swept_sine_equals_the_linearised_transfer_function(sweep_run):
     yaw-rate and ay transfer functions per steering-wheel degree equal the swept sine's FFT
     estimate at five frequencies from 0.2 to 1.8 Hz (gain 2 %, phase 2 deg; the estimator's
     own accuracy on a known system is 4 % and 1.5 deg)."""
-    from jaxveh import analysis
-
     car, run = sweep_run
     r = frequency_response(run.ts, run.channels, f_max=F_MAX)
-    lin = analysis.linearise(car, SPEED, outputs=("yaw_rate", "ay"))
+    lin = analysis.linearise(car, SPEED)
     for target in (0.2, 0.5, 1.0, 1.5, 1.8):
         k = int(np.argmin(np.abs(r["frequency_hz"] - target)))
         h = analysis.transfer_function(lin, r["frequency_hz"][k], "steering")[0] * np.pi / 180.0  # per deg
@@ -120,3 +123,24 @@ def test_swept_sine_equals_the_linearised_transfer_function(sweep_run):
             np.testing.assert_allclose(r[f"{name}_gain"][k], np.abs(exact), rtol=0.02, err_msg=f"{name} {target}")
             phase = np.rad2deg(np.angle(exact * np.exp(-1j * np.deg2rad(r[f"{name}_phase_deg"][k]))))
             assert abs(phase) < 2.0, (name, target, phase)
+
+
+@pytest.mark.slow
+def test_straight_running_linear_model_is_decoupled_for_a_symmetric_car(sweep_run):
+    """On the rigid car with mirror-symmetric tyres, heave (symmetric) moves no lateral
+    channel and steering (antisymmetric) no symmetric one (the axle's summed loads)."""
+    car = sweep_run[0]  # the rigid car: its linearisation program serves the test above too
+    car = eqx.tree_at(lambda c: c.params.tyres, car, mirror_symmetric(car.params.tyres))
+    lin = analysis.linearise(car, SPEED)
+    f = np.asarray([0.5, 2.0, 8.0, 17.0])
+    heave = analysis.transfer_function(lin, f, "heave")
+    steer = analysis.transfer_function(lin, f, "steering")
+    lateral = [analysis.output_index(lin, n) for n in ("yaw_rate", "ay", "roll", "sideslip")]
+    scale_heave = np.abs(heave[:, analysis.output_index(lin, "fz.front_left")]).max()
+    assert np.abs(heave[:, lateral]).max() <= 1e-9 * np.abs(steer[:, lateral]).max()
+    for axle in ("front", "rear"):
+        total = sum(steer[:, analysis.output_index(lin, f"fz.{axle}_{side}")] for side in ("left", "right"))
+        assert np.abs(total).max() <= 1e-9 * scale_heave, axle
+    left, right = (analysis.output_index(lin, f"fz.front_{s}") for s in ("left", "right"))
+    np.testing.assert_allclose(heave[:, left], heave[:, right], rtol=1e-9)
+    assert np.abs(steer[:, left]).max() > 1e-3 * scale_heave  # steering does move the loads, left against right

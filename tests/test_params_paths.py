@@ -24,7 +24,8 @@ def test_paths_parse():
 def test_get_and_set_leaves_and_elements(car):
     p = car.params
     assert float(get_at(p, "arb_rates[0]")) == float(p.arb_rates[0])
-    q = set_all(p, {"arb_rates[1]": 123.0, "chassis.stiffness_scale": 2.0, "vehicle.hard_points_front.points[4, 2]": 0.1})
+    q = set_all(p, {"arb_rates[1]": 123.0, "chassis.stiffness_scale": 2.0,
+                    "vehicle.hard_points_front.points[4, 2]": 0.1})
     np.testing.assert_array_equal(q.arb_rates, [p.arb_rates[0], 123.0])
     np.testing.assert_array_equal(q.chassis.stiffness_scale, np.full(6, 2.0))  # a scalar fills the leaf
     assert float(q.vehicle.hard_points_front.points[4, 2]) == 0.1

@@ -304,8 +304,8 @@ def test_mirror_symmetric_tyre_is_exactly_symmetric():
     alpha, gamma = rng.uniform(-0.3, 0.3, 200), rng.uniform(-0.08, 0.08, 200)
     parity = {"fx": 1.0, "fy": -1.0, "mx": -1.0, "my": 1.0, "mz": -1.0}
     for t, symmetric in ((tyre, False), (mirror_symmetric(tyre), True)):
-        left = jax.vmap(lambda *x: tyre_forces(t, *x))(fz, kappa, alpha, gamma)
-        right = jax.vmap(lambda *x: tyre_forces(t, *x))(fz, kappa, -alpha, -gamma)
+        left = jax.vmap(lambda *x, t=t: tyre_forces(t, *x))(fz, kappa, alpha, gamma)
+        right = jax.vmap(lambda *x, t=t: tyre_forces(t, *x))(fz, kappa, -alpha, -gamma)
         gaps = {k: float(np.max(np.abs(getattr(left, k) - s * getattr(right, k))) / np.max(np.abs(getattr(left, k))))
                 for k, s in parity.items()}
         if symmetric:

@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from .._core import ParameterError
-from ._linear import CarLinearisation, linearise
+from ._linear import DEFAULT_OUTPUTS, CarLinearisation, linearise
 
 SWEEPS = ("coupling", "speed", "first-mode")
 #: Default sweep values and their unit.
@@ -115,7 +115,7 @@ def root_locus(car, sweep: str, values=None, speed: float = 50.0 / 3.6, min_mac:
     values = _check(car, sweep, values)
     if not 0.0 < min_mac < 1.0:
         raise ParameterError(f"min_mac = {min_mac!r} is out of range: allowed (0, 1)")
-    outputs = ("fz",)
+    outputs = DEFAULT_OUTPUTS  # the program every default linearisation uses
 
     def point(value):
         c, s = _car_at(car, sweep, value)
