@@ -205,7 +205,10 @@ def root_locus(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
         write_json(report, out / "root_locus.json")
         loci = {f"{k + 1}: {m['label']}": (np.asarray(m["real_per_s"]) + 2j * np.pi * np.asarray(m["frequency_hz"]))
                 [:, None] for k, m in enumerate(report["modes"])}
-        plots.save(plots.plot_root_locus(loci, title=f"root locus, {sweep} sweep (Fig. 7.7)"), out / "root_locus.png")
+        fig = plots.plot_root_locus(loci, title=f"root locus, {sweep} sweep (Fig. 7.7; square: start, circle: end)")
+        fig.set_size_inches(9.5, 5.5)
+        fig.axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside the loci, not on them
+        plots.save(fig, out / "root_locus.png")
     if as_json:
         emit_json(report)
         return
