@@ -145,6 +145,29 @@ def test_thesis_findings_heave_is_rigid_warp_is_not(car, lin):
     assert set(np.argsort(warp_modes)[-2:]) == {0, 1}
 
 
+@pytest.mark.slow
+def test_eigenvalue_derivatives_equal_central_differences(car, lin):
+    """d lambda / d µ_1 (the first chassis mode's stiffness multiplier) of every mode, by
+    forward-mode autodiff through the trim and the Jacobian, equals central differences of
+    the linearisation's eigenvalues (step 1e-4): 1e-6 of the largest derivative (measured
+    below 1e-8 relative on every mode that moves)."""
+    lam, d = analysis.eigenvalue_sensitivities(car, analysis.stiffness_direction(car, 0), SPEED)
+    np.testing.assert_allclose(lam, analysis.modes(lin)[0], rtol=1e-10)
+    h = 1e-4
+
+    def eigenvalues(scale):
+        moved = eqx.tree_at(lambda c: c.params.chassis.stiffness_scale, car,
+                            car.params.chassis.stiffness_scale.at[0].set(scale))
+        return analysis.modes(analysis.linearise(moved, SPEED))[0]
+
+    plus, minus = eigenvalues(1.0 + h), eigenvalues(1.0 - h)
+    fd = np.asarray([plus[np.argmin(np.abs(plus - x))] - minus[np.argmin(np.abs(minus - x))] for x in lam]) / (2 * h)
+    np.testing.assert_allclose(d, fd, rtol=0.0, atol=1e-6 * np.max(np.abs(fd)))
+    assert np.max(np.abs(d.imag)) > 10.0  # rad/s per unit µ: the chassis modes move with their stiffness
+    with pytest.raises(ParameterError, match="mode = 6"):
+        analysis.stiffness_direction(car, 6)
+
+
 # ---- the time run against the linearisation ----------------------------------------------------
 
 @pytest.fixture(scope="module")

@@ -18,10 +18,12 @@ from ._linear import (
     DEFAULT_OUTPUTS as DEFAULT_OUTPUTS,
     INPUTS as INPUTS,
     CarLinearisation as CarLinearisation,
+    eigenvalue_sensitivities as eigenvalue_sensitivities,
     input_direction as input_direction,
     linearise as linearise,
     modes as modes,
     output_index as output_index,
+    stiffness_direction as stiffness_direction,
     transfer_function as transfer_function,
 )
 from ._load_transfer import (

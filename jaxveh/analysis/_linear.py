@@ -215,3 +215,45 @@ def modes(lin: CarLinearisation, min_hz: float = 1e-3):
     lam, vec = lam[keep], vec[:, keep]
     order = np.argsort(np.abs(lam))
     return lam[order], vec[:, order]
+
+
+def _state_matrix(params, car, speed):
+    car = eqx.tree_at(lambda c: c.params, car, params)
+    return _linearise(car, speed, ("fz",))[0]
+
+
+_compiled_tangent = eqx.filter_jit(lambda car, tangent, speed: jax.jvp(
+    lambda p: _state_matrix(p, car, speed), (car.params,), (tangent,)))
+
+
+def eigenvalue_sensitivities(car, tangent, speed: float = 50.0 / 3.6):
+    """``(eigenvalues, derivatives)``: the modes of :func:`modes` (same order) and the
+    derivative of each eigenvalue (1/s per unit of the direction) along ``tangent``, a
+    direction in ``car.params`` (a :class:`jaxveh.vehicle.CarParams` of tangents, e.g. 1 on
+    ``chassis.stiffness_scale[0]`` and 0 elsewhere), by forward-mode autodiff through the
+    straight-running trim (implicit function theorem) and the Jacobian, and the first-order
+    eigenvalue perturbation ``d lambda = w^H dA v / (w^H v)`` (left and right eigenvectors;
+    simple eigenvalues)."""
+    import scipy.linalg
+
+    check_car(car)
+    if jax.tree.structure(tangent) != jax.tree.structure(car.params):
+        raise ParameterError("tangent must have the structure of car.params (a CarParams of tangents)")
+    speed = jnp.asarray(speed, jnp.float64)
+    with run_time_checks_off():
+        a, da = _compiled_tangent(car, tangent, speed)
+    lam, left, right = scipy.linalg.eig(np.asarray(a), left=True, right=True)
+    keep = (np.abs(lam) >= 2.0 * np.pi * 1e-3) & (lam.imag >= 0.0)
+    order = np.argsort(np.abs(lam[keep]))
+    lam, left, right = lam[keep][order], left[:, keep][:, order], right[:, keep][:, order]
+    da = np.asarray(da)
+    d = np.einsum("ik,ij,jk->k", left.conj(), da, right) / np.einsum("ik,ik->k", left.conj(), right)
+    return lam, d
+
+
+def stiffness_direction(car, mode: int):
+    """A tangent of ``car.params``: 1 on ``chassis.stiffness_scale[mode]`` (0-based), 0 elsewhere."""
+    if car.n_modes == 0 or not 0 <= mode < car.n_modes:
+        raise ParameterError(f"mode = {mode!r} is out of range: allowed 0 to {car.n_modes - 1} (the car's modes)")
+    zero = jax.tree.map(jnp.zeros_like, car.params)
+    return eqx.tree_at(lambda p: p.chassis.stiffness_scale, zero, jnp.zeros(car.n_modes).at[mode].set(1.0))
