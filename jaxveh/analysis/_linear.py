@@ -21,6 +21,7 @@ import jax
 import jax.flatten_util
 import jax.numpy as jnp
 import numpy as np
+import scipy.linalg
 from jaxtyping import Array, Float
 
 from .._core import ParameterError, run_time_checks_off
@@ -211,10 +212,14 @@ def modes(lin: CarLinearisation, min_hz: float = 1e-3):
     negative (the car's vibration modes and its non-oscillating ones), leaving out the
     neutral ones (``|lambda| < 2 pi min_hz``), by rising natural frequency. NumPy."""
     lam, vec = np.linalg.eig(np.asarray(lin.a))
-    keep = (np.abs(lam) >= 2.0 * np.pi * min_hz) & (lam.imag >= 0.0)
-    lam, vec = lam[keep], vec[:, keep]
-    order = np.argsort(np.abs(lam))
+    order = _mode_order(lam, min_hz)
     return lam[order], vec[:, order]
+
+
+def _mode_order(lam, min_hz: float = 1e-3) -> np.ndarray:
+    """Indices of the eigenvalues ``lam`` that :func:`modes` keeps, by rising modulus."""
+    keep = np.flatnonzero((np.abs(lam) >= 2.0 * np.pi * min_hz) & (lam.imag >= 0.0))
+    return keep[np.argsort(np.abs(lam[keep]))]
 
 
 def _state_matrix(params, car, speed):
@@ -234,8 +239,6 @@ def eigenvalue_sensitivities(car, tangent, speed: float = 50.0 / 3.6):
     straight-running trim (implicit function theorem) and the Jacobian, and the first-order
     eigenvalue perturbation ``d lambda = w^H dA v / (w^H v)`` (left and right eigenvectors;
     simple eigenvalues)."""
-    import scipy.linalg
-
     check_car(car)
     if jax.tree.structure(tangent) != jax.tree.structure(car.params):
         raise ParameterError("tangent must have the structure of car.params (a CarParams of tangents)")
@@ -243,9 +246,8 @@ def eigenvalue_sensitivities(car, tangent, speed: float = 50.0 / 3.6):
     with run_time_checks_off():
         a, da = _compiled_tangent(car, tangent, speed)
     lam, left, right = scipy.linalg.eig(np.asarray(a), left=True, right=True)
-    keep = (np.abs(lam) >= 2.0 * np.pi * 1e-3) & (lam.imag >= 0.0)
-    order = np.argsort(np.abs(lam[keep]))
-    lam, left, right = lam[keep][order], left[:, keep][:, order], right[:, keep][:, order]
+    order = _mode_order(lam)
+    lam, left, right = lam[order], left[:, order], right[:, order]
     da = np.asarray(da)
     d = np.einsum("ik,ij,jk->k", left.conj(), da, right) / np.einsum("ik,ik->k", left.conj(), right)
     return lam, d

@@ -239,12 +239,16 @@ def chi_vs_mode_stiffness(car, mus, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_PAIR_G) 
     return chi.reshape(car.n_modes, -1)
 
 
+def _check_max_modes(max_modes, low: int) -> None:
+    if isinstance(max_modes, bool) or not isinstance(max_modes, (int, np.integer)) or not low <= max_modes <= 20:
+        raise ParameterError(f"max_modes = {max_modes!r} is out of range: allowed integers {low} to 20")
+
+
 def chi_vs_modes(max_modes: int = 6, path=None, radius=SKID_PAD_RADIUS, ay_g=LOW_AY_PAIR_G) -> Float[Array, " n"]:
     """χ between the two ``ay_g`` (g) of the car file ``path`` (default: the shipped car) with 0 (rigid)
     to ``max_modes`` chassis modes (Fig. 7.2c). Each mode count is its own structure and so
     its own compiled program (about a minute or two each on two cores)."""
-    if isinstance(max_modes, bool) or not isinstance(max_modes, (int, np.integer)) or not 0 <= max_modes <= 20:
-        raise ParameterError(f"max_modes = {max_modes!r} is out of range: allowed integers 0 to 20")
+    _check_max_modes(max_modes, 0)
     return jnp.stack([load_transfer(load_car(path, modes=n), ay_g, radius).chi_low_ay
                       for n in range(max_modes + 1)])
 
@@ -271,8 +275,7 @@ def chi_by_modes(max_modes: int = 10, path=None, radius=SKID_PAD_RADIUS, ay_g=LO
     modal truncation keeps the first modes' shapes, so the first k modes of the larger car
     are the k-mode car's, and a frozen mode's share of χ is below 1e-7 (tested against
     :func:`chi_vs_modes`, which compiles one program per mode count)."""
-    if isinstance(max_modes, bool) or not isinstance(max_modes, (int, np.integer)) or not 1 <= max_modes <= 20:
-        raise ParameterError(f"max_modes = {max_modes!r} is out of range: allowed integers 1 to 20")
+    _check_max_modes(max_modes, 1)
     car = load_car(path, modes=max_modes)
     return load_transfer_batch(car, truncation_designs(car), ay_g, radius).chi_low_ay
 

@@ -139,9 +139,7 @@ def root_locus(car, sweep: str, values=None, speed: float = 50.0 / 3.6, min_mac:
             macs.append(mac)
     lam = np.stack(tracked_lam)
     keep = (lam.imag.mean(axis=0) >= -1e-12) & (np.abs(lam).min(axis=0) >= 2.0 * np.pi * 1e-3)
-    last_car, last_speed = _car_at(car, sweep, tracked_values[-1])
-    lin = linearise(last_car, speed if last_speed is None else last_speed, outputs=outputs)
-    labels = tuple(mode_label(last_car, lin, tracked_vec[-1][:, j], lam[-1, j]) for j in np.flatnonzero(keep))
+    labels = tuple(mode_label(car, tracked_vec[-1][:, j]) for j in np.flatnonzero(keep))
     order = np.argsort(np.abs(lam[-1, keep]))
     return RootLocus(sweep=sweep, unit=DEFAULT_VALUES[sweep][1], values=np.asarray(tracked_values),
                      eigenvalues=lam[:, keep][:, order], labels=tuple(labels[k] for k in order),
@@ -149,16 +147,18 @@ def root_locus(car, sweep: str, values=None, speed: float = 50.0 / 3.6, min_mac:
                      speed=float(speed if sweep != "speed" else np.nan))
 
 
-def kinetic_energy_shares(car, lin: CarLinearisation, vector) -> dict:
-    """Shares of a mode's kinetic energy (lumped masses, see the module docs) by group."""
-    v = vector[lin.n_q : 2 * lin.n_q]
+def kinetic_energy_shares(car, vector) -> dict:
+    """Shares of a mode's kinetic energy (lumped masses, see the module docs) by group;
+    ``vector`` an eigenvector of the fast car's state ``[q, u, aux]``."""
+    n_q = 14 + car.n_modes
+    v = vector[n_q : 2 * n_q]
     p = car.params.vehicle
     m = float(np.asarray(p.sprung.mass))
     inertia = np.diag(np.asarray(p.sprung.inertia))
     unsprung = [float(np.asarray(p.unsprung_front.body.mass)), float(np.asarray(p.unsprung_rear.body.mass))]
     spin_inertia = np.repeat([float(np.asarray(p.unsprung_front.wheel_spin_inertia)),
                               float(np.asarray(p.unsprung_rear.wheel_spin_inertia))], 2)
-    n = lin.n_modes
+    n = car.n_modes
     travel, spin = v[6 + n : 10 + n], v[10 + n : 14 + n]
     e = {
         "longitudinal": m * abs(v[0]) ** 2,
@@ -177,10 +177,11 @@ def kinetic_energy_shares(car, lin: CarLinearisation, vector) -> dict:
     return {k: x / total for k, x in e.items()} if total > 0.0 else {}
 
 
-def mode_label(car, lin: CarLinearisation, vector, eigenvalue) -> str:
-    """The label of one mode (see the module docs)."""
-    shares = kinetic_energy_shares(car, lin, vector)
-    velocity = np.linalg.norm(vector[lin.n_q : 2 * lin.n_q])
+def mode_label(car, vector) -> str:
+    """The label of one mode of the fast car (its eigenvector; see the module docs)."""
+    shares = kinetic_energy_shares(car, vector)
+    n_q = 14 + car.n_modes
+    velocity = np.linalg.norm(vector[n_q : 2 * n_q])
     if not shares or velocity < 1e-3 * np.linalg.norm(vector):
         return "lag"
     top = max(shares, key=shares.get)
