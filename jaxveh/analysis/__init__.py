@@ -1,7 +1,9 @@
 """Chapter-7 analyses of the chapter-6 car: lateral load transfer and its distribution χ
 (section 7.1.2, Fig. 7.2) against ay, the roll stiffness distribution λ, the number of
 chassis modes and each mode's stiffness, beside the chapter-3 model (eqs. 3.2-3.6) fed
-with the car's own parameters. See docs/analysis.md."""
+with the car's own parameters; the suspension kinematics under chassis deformation
+(projection matrices, Table 7.1's kinematic gradients, modal coordinates on the skid-pad);
+exact linearisation, eigenvalue derivatives and root loci. See docs/analysis.md."""
 
 from ._chapter3 import (
     Chapter3Parameters as Chapter3Parameters,
@@ -13,6 +15,19 @@ from ._chapter3 import (
     roll_centre_heights as roll_centre_heights,
     static_sink as static_sink,
     with_lambda as with_lambda,
+)
+from ._kinematics import (
+    THESIS_TABLE_7_1 as THESIS_TABLE_7_1,
+    WHEEL_PARAMETERS as WHEEL_PARAMETERS,
+    KinematicGradients as KinematicGradients,
+    ProjectionMatrices as ProjectionMatrices,
+    gradient_table as gradient_table,
+    kinematic_gradients as kinematic_gradients,
+    kinematic_gradients_report as kinematic_gradients_report,
+    modal_ay_dependence as modal_ay_dependence,
+    modes_vs_sprung_mass as modes_vs_sprung_mass,
+    projection_matrices as projection_matrices,
+    wheel_parameters as wheel_parameters,
 )
 from ._linear import (
     DEFAULT_OUTPUTS as DEFAULT_OUTPUTS,

@@ -25,7 +25,7 @@ import scipy.linalg
 from jaxtyping import Array, Float
 
 from .._core import ParameterError, run_time_checks_off
-from ..manoeuvre import PATH_CHANNELS, UNITS, car_channels, straight_trim
+from ..manoeuvre import UNITS, car_channels, straight_trim
 from ..manoeuvre._road import POST_PATTERNS
 from ..manoeuvre._simulate import _compiled_trim
 from ..multibody import TimeInputs
@@ -91,10 +91,14 @@ def output_names(car, channels=DEFAULT_OUTPUTS) -> tuple[str, ...]:
     return tuple(names)
 
 
+#: Channels that cannot be linearised: the distance run (it grows along the trim) and the input.
+_NOT_LINEARISED = ("x", "steering_wheel_angle")
+
+
 def _check_outputs(channels):
-    bad = [c for c in channels if c not in UNITS or c in PATH_CHANNELS or c == "steering_wheel_angle"]
+    bad = [c for c in channels if c not in UNITS or c in _NOT_LINEARISED]
     if bad or not channels:
-        allowed = [c for c in UNITS if c not in PATH_CHANNELS and c != "steering_wheel_angle"]
+        allowed = [c for c in UNITS if c not in _NOT_LINEARISED]
         raise ParameterError(f"outputs = {tuple(channels)!r}: allowed one or more of {', '.join(allowed)}")
     return tuple(channels)
 
@@ -222,13 +226,32 @@ def _mode_order(lam, min_hz: float = 1e-3) -> np.ndarray:
     return keep[np.argsort(np.abs(lam[keep]))]
 
 
-def _state_matrix(params, car, speed):
+def _lateral_matrices(params, car, speed):
+    """``(a, b, c)`` of the car with ``params``, the output the c.g.'s lateral position."""
     car = eqx.tree_at(lambda c: c.params, car, params)
-    return _linearise(car, speed, ("fz",))[0]
+    return _linearise(car, speed, ("y",))[:3]
 
 
+#: ``((a, b, c), (da, db, dc))`` along a direction in the car's parameters (one program per
+#: car structure serves the eigenvalue derivatives and the preview distance's).
 _compiled_tangent = eqx.filter_jit(lambda car, tangent, speed: jax.jvp(
-    lambda p: _state_matrix(p, car, speed), (car.params,), (tangent,)))
+    lambda p: _lateral_matrices(p, car, speed), (car.params,), (tangent,)))
+
+
+def _check_tangent(car, tangent):
+    check_car(car)
+    if jax.tree.structure(tangent) != jax.tree.structure(car.params):
+        raise ParameterError("tangent must have the structure of car.params (a CarParams of tangents)")
+
+
+def linear_tangent(car, tangent, speed: float = 50.0 / 3.6):
+    """``((a, b, c), (da, db, dc))``: the linearisation about straight running at ``speed``
+    (m/s) with the c.g.'s lateral position ``y`` as output, and its derivative along
+    ``tangent`` (a :class:`jaxveh.vehicle.CarParams` of tangents), by forward-mode autodiff
+    through the trim (implicit function theorem) and the Jacobians."""
+    _check_tangent(car, tangent)
+    with run_time_checks_off():
+        return _compiled_tangent(car, tangent, jnp.asarray(speed, jnp.float64))
 
 
 def eigenvalue_sensitivities(car, tangent, speed: float = 50.0 / 3.6):
@@ -239,12 +262,7 @@ def eigenvalue_sensitivities(car, tangent, speed: float = 50.0 / 3.6):
     straight-running trim (implicit function theorem) and the Jacobian, and the first-order
     eigenvalue perturbation ``d lambda = w^H dA v / (w^H v)`` (left and right eigenvectors;
     simple eigenvalues)."""
-    check_car(car)
-    if jax.tree.structure(tangent) != jax.tree.structure(car.params):
-        raise ParameterError("tangent must have the structure of car.params (a CarParams of tangents)")
-    speed = jnp.asarray(speed, jnp.float64)
-    with run_time_checks_off():
-        a, da = _compiled_tangent(car, tangent, speed)
+    (a, _, _), (da, _, _) = linear_tangent(car, tangent, speed)
     lam, left, right = scipy.linalg.eig(np.asarray(a), left=True, right=True)
     order = _mode_order(lam)
     lam, left, right = lam[order], left[:, order], right[:, order]

@@ -252,3 +252,43 @@ def lltd_modes(vehicle: Path = VehicleOpt,
                f"{report['chi_eq36']:.4f}):")
     for n, c in zip(report["modes"], report["chi_by_modes"], strict=True):
         typer.echo(f"  {n:2d} modes: {c:.4f}")
+
+
+@vehicle_app.command("kinematic-gradients")
+def kinematic_gradients(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
+                        radius: float = typer.Option(50.0, "--radius", help="skid-pad radius (m)"),
+                        ay_ref_g: float = typer.Option(0.3, "--ay-ref-g", help="lateral acceleration the gradients "
+                                                       "are taken at (g; a multiple of 0.05 g)"),
+                        as_json: bool = JsonOpt, out: Path = OutOpt) -> None:
+    """Table 7.1: camber and toe-in change per g of lateral acceleration due to the chassis
+    deformation (deformation gradients of the projection matrix R times the modal
+    coordinates' exact gradients on the skid-pad, turning left), front and rear left wheels,
+    beside the thesis's; with --out also Fig. 7.4 (full model vs linear approximation)."""
+    from ..analysis import kinematic_gradients_report
+    from ._simulate import _compilation_cache
+
+    _compilation_cache()
+    if not radius > 0.0:
+        fail(f"--radius must be > 0 (m), got {radius:g}")
+    try:
+        report = kinematic_gradients_report(_car(vehicle, modes), radius, ay_ref_g)
+    except (*_errors(), RuntimeError) as e:
+        fail(str(e))
+    if out is not None:
+        from .. import plots
+
+        out = Path(out)
+        write_json(report, out / "kinematic_gradients.json")
+        plots.save(plots.plot_kinematic_gradients(report, title=f"effect of the chassis on the kinematics, "
+                                                  f"R = {radius:g} m (Fig. 7.4)"), out / "kinematic_gradients.png")
+    if as_json:
+        emit_json(report)
+        return
+    typer.echo(f"kinematic gradients due to the chassis ({modes} modes, R = {radius:g} m, at "
+               f"{report['reference_ay_g']:.2f} g, left wheels; thesis Table 7.1 in brackets):")
+    for axle in ("front", "rear"):
+        r, t = report[axle], report["thesis_table_7_1"][axle]
+        typer.echo(f"  {axle:>5}: camber {r['camber_deg_per_g']:+.4f} ({t['camber_deg_per_g']:+.3f}) deg/g, "
+                   f"toe-in {r['toe_deg_per_g']:+.4f} ({t['toe_deg_per_g']:+.3f}) deg/g")
+    if out is not None:
+        typer.echo(f"wrote {out}")

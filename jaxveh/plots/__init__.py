@@ -11,6 +11,11 @@ from ._chapter3 import (
     plot_step_steer as plot_step_steer,
     save as save,
 )
+from ._kinematics import (
+    plot_kinematic_gradients as plot_kinematic_gradients,
+    plot_modal_coordinates as plot_modal_coordinates,
+    plot_projection_matrices as plot_projection_matrices,
+)
 from ._manoeuvres import (
     plot_four_post as plot_four_post,
     plot_frequency_response as plot_frequency_response,

@@ -1,0 +1,87 @@
+"""Figures of the chassis's effect on the suspension kinematics (thesis Figs 7.1, 7.3, 7.4)."""
+
+import numpy as np
+
+from ._chapter3 import figure
+
+#: Colours of the wheel parameters in the projection-matrix map (Fig. 7.3b's legend).
+_PARAMETER_COLOURS = {"wheelbase": "tab:blue", "half_track": "tab:green", "height": "black", "toe": "tab:red",
+                      "camber": "tab:orange", "caster": "tab:purple"}
+
+
+def plot_kinematic_gradients(report: dict, title: str = ""):
+    """Fig. 7.4: front- and rear-left camber (inclination) and toe-in change due to the
+    chassis against ay, the full model beside the linear approximation of Table 7.1 (a
+    :func:`jaxveh.analysis.kinematic_gradients_report`)."""
+    c = report["curve"]
+    ay = np.asarray(c["ay_g"])
+    fig, axes = figure(2, 2, figsize=(10, 7))
+    for ax, (quantity, unit), (corner, k) in (
+        (axes[0, 0], ("camber", "Δγ"), ("front left", 0)), (axes[0, 1], ("toe", "Δδ toe-in"), ("front left", 0)),
+        (axes[1, 0], ("camber", "Δγ"), ("rear left", 2)), (axes[1, 1], ("toe", "Δδ toe-in"), ("rear left", 2)),
+    ):
+        ax.plot(ay, np.asarray(c[f"{quantity}_full_deg"])[:, k], "-", label="full model")
+        ax.plot(ay, np.asarray(c[f"{quantity}_linear_deg"])[:, k], "--", label="linear approx.")
+        ax.set_xlabel("ay [g]")
+        ax.set_ylabel(f"{unit} [deg]")
+        ax.set_title(f"{corner} {quantity}", fontsize=9)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def plot_modal_coordinates(ay_g, modes, masses=None, modes_by_mass=None, title: str = ""):
+    """Fig. 7.1: the modal coordinates' magnitudes against ay (g) and, with ``masses`` (kg),
+    against the sprung mass."""
+    panels = 1 if masses is None else 2
+    fig, axes = figure(1, panels, figsize=(6 * panels, 4.2), squeeze=False)
+    modes = np.abs(np.asarray(modes))
+    for k in range(modes.shape[1]):
+        axes[0, 0].plot(ay_g, 1e3 * modes[:, k], label=f"mode {k + 1}")
+    axes[0, 0].set_xlabel("ay [g]")
+    if masses is not None:
+        by_mass = np.abs(np.asarray(modes_by_mass))
+        for k in range(by_mass.shape[1]):
+            axes[0, 1].plot(masses, 1e3 * by_mass[:, k], "o-", label=f"mode {k + 1}")
+        axes[0, 1].set_xlabel("sprung mass [kg]")
+    for ax in axes[0]:
+        ax.set_ylabel("|p_i| [1e-3]")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def plot_projection_matrices(pm, title: str = ""):
+    """Fig. 7.3: non-zero entries of ``TR`` (a) and ``R`` (b) of a
+    :class:`jaxveh.analysis.ProjectionMatrices` with the bodies' partitions; in ``R`` each
+    corner's wheel-parameter rows as triangles (up positive, down negative) coloured by
+    parameter, the other entries as dots."""
+    fig, axes = figure(1, 2, figsize=(12, 8.5))
+    for ax, matrix, name, coloured in ((axes[0], pm.tr, "(a) TR", False), (axes[1], pm.r, "(b) R", True)):
+        m = np.asarray(matrix)
+        rows, cols = np.nonzero(np.abs(m) > 1e-10 * np.max(np.abs(m)))
+        for i, j in zip(rows, cols):
+            parameter = pm.rows[i].split(".")[-1]
+            if coloured and parameter in _PARAMETER_COLOURS:
+                ax.plot(j + 1, i + 1, "^" if m[i, j] > 0 else "v", color=_PARAMETER_COLOURS[parameter], ms=5)
+            else:
+                ax.plot(j + 1, i + 1, ".", color="black", ms=4)
+        for r in pm.row_groups[1:]:
+            ax.axhline(r + 0.5, color="grey", lw=0.6)
+        for c in pm.column_groups[1:]:
+            ax.axvline(c + 0.5, color="grey", lw=0.6)
+        ax.set_xlim(0.5, m.shape[1] + 0.5)
+        ax.set_ylim(m.shape[0] + 0.5, 0.5)
+        ax.set_xlabel("independent coordinate s_j")
+        ax.set_ylabel("relative coordinate" if coloured else "absolute coordinate")
+        ax.set_title(name, fontsize=10)
+    for parameter, colour in _PARAMETER_COLOURS.items():
+        axes[1].plot([], [], "^", color=colour, label=parameter.replace("_", " "))
+    axes[1].legend(fontsize=8, loc="lower left")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
