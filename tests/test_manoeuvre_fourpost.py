@@ -282,3 +282,94 @@ def test_cli_root_locus_speed_json():
     assert lateral and all(m["min_neighbour_mac"] >= 0.8 for m in report["modes"])
     spread = max(np.ptp(m["real_per_s"]) for m in lateral)
     assert spread > 1.0  # 1/s: the handling modes depend on speed
+
+
+# ---- optimal preview on the linearised car (Fig. 7.10) ------------------------------------------
+
+PREVIEW_SPEED = 100.0 / 3.6
+
+
+@pytest.fixture(scope="module")
+def preview_lin(car):
+    return analysis.linearise(car, PREVIEW_SPEED, outputs=("y",))
+
+
+def test_preview_plant_realisation_is_exact(preview_lin):
+    """The plant without the input's derivatives (B0 + A B1 + A^2 B2, neutral states
+    dropped) and its reported feedthrough give the linearisation's exact steering-to-lateral-
+    position transfer function at 0.3, 1 and 3 Hz (1e-9)."""
+    from jaxveh.analysis._preview import _plant
+
+    a, b, c = (np.asarray(x) for x in (preview_lin.a, preview_lin.b, preview_lin.c))
+    a_k, b_k, c_k, feed = (np.asarray(x) for x in _plant(a, b, c, preview_lin.n_q))
+    assert a_k.shape == (a.shape[0] - 5,) * 2
+    full = analysis.transfer_function(preview_lin, [0.3, 1.0, 3.0], "steering")[:, 0]
+    for f, h in zip([0.3, 1.0, 3.0], full, strict=True):
+        s = 2j * np.pi * f
+        reduced = c_k @ np.linalg.solve(s * np.eye(a_k.shape[0]) - a_k, b_k) + feed[0] + s * feed[1]
+        np.testing.assert_allclose(reduced, h, rtol=1e-9)
+
+
+@pytest.mark.slow
+def test_preview_thesis_findings_and_truncation(car):
+    """Fig. 7.10: the closed loop is stable, the gains die out within the 250 points, and
+    the chassis's flexibility lengthens the preview (rigid: all modes frozen); the first-k
+    truncation with k = n is the car itself."""
+    by_modes = analysis.preview_by_modes(car)
+    full = analysis.car_preview(car)
+    assert len(by_modes) == car.n_modes + 1
+    np.testing.assert_allclose(float(by_modes[-1].lp), float(full.lp), rtol=1e-12)
+    kp = np.abs(np.asarray(full.gains))
+    assert float(full.spectral_radius) < 1.0 and np.max(kp[-25:]) < 1e-2 * np.max(kp)
+    assert float(full.lp) > float(by_modes[0].lp) + 0.5  # m: a longer preview on the flexible chassis
+    with pytest.raises(ParameterError, match="n_preview = 1"):
+        analysis.car_preview(car, n_preview=1)
+
+
+@pytest.mark.slow
+def test_preview_distance_derivative_equals_central_differences(car):
+    """d Lp / d µ_1 by forward mode through the trim, the Jacobians and the Riccati equation
+    equals central differences of the (interpolated) preview distance, step 1e-3: 1e-4."""
+    lp, dlp = analysis.preview_distance_sensitivity(car, 0)
+
+    def distance(scale):
+        moved = eqx.tree_at(lambda c: c.params.chassis.stiffness_scale, car,
+                            car.params.chassis.stiffness_scale.at[0].set(scale))
+        return float(analysis.car_preview(moved).lp)
+
+    h = 1e-3
+    fd = (distance(1.0 + h) - distance(1.0 - h)) / (2 * h)
+    np.testing.assert_allclose(float(lp), distance(1.0), rtol=1e-12)
+    assert abs(fd) > 1e-2  # m per unit µ: the first mode's stiffness moves the preview
+    np.testing.assert_allclose(float(dlp), fd, rtol=1e-4)
+
+
+@pytest.mark.slow
+def test_cli_preview_json():
+    result = CliRunner().invoke(app, ["vehicle", "preview", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert out["speed_kmh"] == 100.0 and out["n_preview"] == 250
+    for key in ("flexible", "rigid"):
+        assert len(out[key]["gains_deg_per_m"]) == 251 and out[key]["preview_distance_m"] > 0.0
+    assert len(out["preview_distance_by_modes_m"]) == 7
+    assert out["chapter_3"]["flexible"]["preview_distance_m"] > 0.0
+    bad = CliRunner().invoke(app, ["vehicle", "preview", "--points", "1"])
+    assert bad.exit_code == 2 and "--points" in bad.output
+
+
+def test_cli_frequency_response_is_the_transfer_function(lin):
+    """``jaxveh vehicle frequency-response``: the linearisation's exact transfer functions in
+    the time runs' units and keys (per deg of steering-wheel angle; per mm of post)."""
+    for input, name, row, per in (("steering", "yaw_rate", "yaw_rate", np.pi / 180.0),
+                                  ("warp", "fz_front_left", "fz.front_left", 1e-3)):
+        result = CliRunner().invoke(app, ["vehicle", "frequency-response", "--input", input, "--f-max", "30",
+                                          "--points", "40", "--json"])
+        assert result.exit_code == 0, result.output
+        out = json.loads(result.stdout)
+        h = analysis.transfer_function(lin, out["frequency_hz"], input)[:, analysis.output_index(lin, row)]
+        np.testing.assert_allclose(out[f"{name}_gain"], np.abs(h) * per, rtol=1e-9)
+        assert len(out["frequency_hz"]) == 40 and out["frequency_hz"][-1] == pytest.approx(30.0)
+    assert "mode_1_gain" in out and "twist_gain" in out
+    bad = CliRunner().invoke(app, ["vehicle", "frequency-response", "--input", "roll"])
+    assert bad.exit_code == 2 and "--input" in bad.output

@@ -31,10 +31,13 @@ from ._kinematics import (
 )
 from ._linear import (
     DEFAULT_OUTPUTS as DEFAULT_OUTPUTS,
+    FRF_OUTPUTS as FRF_OUTPUTS,
     INPUTS as INPUTS,
     CarLinearisation as CarLinearisation,
     eigenvalue_sensitivities as eigenvalue_sensitivities,
     input_direction as input_direction,
+    linear_frequency_response as linear_frequency_response,
+    linear_tangent as linear_tangent,
     linearise as linearise,
     modes as modes,
     output_index as output_index,
@@ -60,6 +63,14 @@ from ._load_transfer import (
     load_transfer_batch as load_transfer_batch,
     mode_stiffness_designs as mode_stiffness_designs,
     truncation_designs as truncation_designs,
+)
+from ._preview import (
+    PreviewResult as PreviewResult,
+    car_preview as car_preview,
+    preview_by_modes as preview_by_modes,
+    preview_distance_sensitivity as preview_distance_sensitivity,
+    preview_report as preview_report,
+    preview_vs_mode_stiffness as preview_vs_mode_stiffness,
 )
 from ._reports import lltd_report as lltd_report
 from ._root_locus import (

@@ -277,3 +277,37 @@ def stiffness_direction(car, mode: int):
         raise ParameterError(f"mode = {mode!r} is out of range: allowed 0 to {car.n_modes - 1} (the car's modes)")
     zero = jax.tree.map(jnp.zeros_like, car.params)
     return eqx.tree_at(lambda p: p.chassis.stiffness_scale, zero, jnp.zeros(car.n_modes).at[mode].set(1.0))
+
+
+#: Outputs of :func:`linear_frequency_response` by default, per input kind.
+FRF_OUTPUTS = {"steering": ("yaw_rate", "ay", "sideslip", "roll", "twist"),
+               "road": ("fz.front_left", "twist", "roll", "travel.front_left")}
+
+
+def linear_frequency_response(lin: CarLinearisation, frequency_hz, input="steering", outputs=None) -> dict:
+    """The exact frequency responses of :func:`transfer_function` in the form of
+    :func:`jaxveh.manoeuvre.frequency_response` and
+    :func:`jaxveh.manoeuvre.four_post_metrics` (``fz.front_left`` becomes
+    ``fz_front_left``, ``modes.1`` ``mode_1``): ``frequency_hz`` and per output
+    ``{name}_gain`` (output units per degree of steering-wheel angle, or per mm at the
+    front-left post for "heave"/"warp"), ``{name}_gain_db`` and ``{name}_phase_deg``
+    (unwrapped from the lowest frequency). ``outputs``: rows of ``lin`` (default
+    :data:`FRF_OUTPUTS` of the input's kind, those present, and every modal coordinate for a
+    road input)."""
+    if outputs is None:
+        kind = "steering" if isinstance(input, str) and input == "steering" else "road"
+        outputs = [o for o in FRF_OUTPUTS[kind] if o in lin.outputs]
+        if kind == "road":
+            outputs += [o for o in lin.outputs if o.startswith("modes.")]
+    rows = [output_index(lin, o) for o in outputs]
+    f = np.atleast_1d(np.asarray(frequency_hz, float))
+    per_unit = np.pi / 180.0 if isinstance(input, str) and input == "steering" else 1e-3
+    h = transfer_function(lin, f, input)[:, rows] * per_unit
+    out = {"frequency_hz": f.tolist()}
+    for output, column in zip(outputs, h.T, strict=True):
+        name = output.replace("modes.", "mode_").replace(".", "_")  # the keys of the time runs' responses
+        gain = np.abs(column)
+        out[f"{name}_gain"] = gain.tolist()
+        out[f"{name}_gain_db"] = (20.0 * np.log10(np.maximum(gain, 1e-300))).tolist()
+        out[f"{name}_phase_deg"] = np.degrees(np.unwrap(np.angle(column))).tolist()
+    return out

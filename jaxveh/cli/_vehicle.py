@@ -292,3 +292,91 @@ def kinematic_gradients(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
                    f"toe-in {r['toe_deg_per_g']:+.4f} ({t['toe_deg_per_g']:+.3f}) deg/g")
     if out is not None:
         typer.echo(f"wrote {out}")
+
+
+@vehicle_app.command("preview")
+def preview(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
+            speed_kmh: float = typer.Option(100.0, "--speed-kmh", help="speed of the straight running, km/h"),
+            points: int = typer.Option(250, "--points", help="preview points (>= 2; the thesis's 250)"),
+            as_json: bool = JsonOpt, out: Path = OutOpt) -> None:
+    """TI-optimal preview control of the linearised car (Fig. 7.10): preview gains and
+    preview distance with all chassis modes, with the first k (k = 0: rigid), beside the
+    chapter-3 model's."""
+    from ..analysis import preview_report
+    from ._simulate import _compilation_cache
+
+    _compilation_cache()
+    if not 0.0 < speed_kmh <= 360.0:
+        fail(f"--speed-kmh must be in (0, 360], got {speed_kmh:g}")
+    if points < 2:
+        fail(f"--points must be >= 2, got {points}")
+    try:
+        report = preview_report(_car(vehicle, modes), speed_kmh, points)
+    except (*_errors(), RuntimeError) as e:
+        fail(str(e))
+    if out is not None:
+        from .. import plots
+
+        out = Path(out)
+        write_json(report, out / "preview.json")
+        plots.save(plots.plot_car_preview(report), out / "preview.png")
+    if as_json:
+        emit_json(report)
+        return
+    lp = {k: report[k]["preview_distance_m"] for k in ("flexible", "rigid")}
+    lp3 = {k: report["chapter_3"][k]["preview_distance_m"] for k in ("flexible", "rigid")}
+    typer.echo(f"preview distance at {speed_kmh:g} km/h ({points} points): flexible {lp['flexible']:.2f} m, rigid "
+               f"{lp['rigid']:.2f} m; chapter-3 model {lp3['flexible']:.2f} / {lp3['rigid']:.2f} m")
+    typer.echo("  by number of modes: " + ", ".join(f"{k}: {lp:.2f}" for k, lp in
+                                                    enumerate(report["preview_distance_by_modes_m"])))
+
+
+@vehicle_app.command("frequency-response")
+def frequency_response(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
+                       input: str = typer.Option("steering", "--input", help="steering, heave or warp (the posts)"),
+                       speed_kmh: float = typer.Option(50.0, "--speed-kmh", help="speed of the straight running, km/h"),
+                       f_max: float = typer.Option(20.0, "--f-max", help="highest frequency, Hz"),
+                       points: int = typer.Option(200, "--points", help="log-spaced frequencies from 0.1 Hz"),
+                       as_json: bool = JsonOpt, out: Path = OutOpt) -> None:
+    """Exact frequency responses of the linearised car (Figs 7.8, 7.9): yaw rate, ay,
+    sideslip, roll and twist per degree of steering-wheel angle, or the front-left tyre load,
+    twist, roll, travel and modal coordinates per mm of post motion (heave: the four posts
+    together, warp: diagonals in anti-phase)."""
+    from ..analysis import linear_frequency_response, linearise
+    from ._simulate import _compilation_cache
+
+    _compilation_cache()
+    if input not in ("steering", "heave", "warp"):
+        fail(f"--input must be steering, heave or warp, got {input!r}")
+    if not 0.0 < speed_kmh <= 360.0:
+        fail(f"--speed-kmh must be in (0, 360], got {speed_kmh:g}")
+    if not 0.1 < f_max <= 200.0:
+        fail(f"--f-max must be in (0.1, 200] Hz, got {f_max:g}")
+    if points < 2:
+        fail(f"--points must be >= 2, got {points}")
+    start = time.perf_counter()
+    try:
+        lin = linearise(_car(vehicle, modes), speed_kmh / 3.6)
+    except (*_errors(), RuntimeError) as e:
+        fail(str(e))
+    f = np.logspace(-1.0, np.log10(f_max), points)
+    report = {"input": input, "speed_kmh": speed_kmh, "modes": modes,
+              "per": "deg of steering-wheel angle" if input == "steering" else "mm at the front-left post",
+              **linear_frequency_response(lin, f, input), "wall_time_s": time.perf_counter() - start}
+    if out is not None:
+        from .. import plots
+
+        out = Path(out)
+        write_json(report, out / "frequency_response.json")
+        title = f"linearised car at {speed_kmh:g} km/h, {input} input"
+        fig = (plots.plot_frequency_response({f"{modes} modes": report}, title=title) if input == "steering"
+               else plots.plot_four_post({f"{modes} modes": report}, title=title))
+        plots.save(fig, out / "frequency_response.png")
+    if as_json:
+        emit_json(report)
+        return
+    names = [k.removesuffix("_gain") for k in report if k.endswith("_gain")]
+    typer.echo(f"frequency responses per {report['per']} at {speed_kmh:g} km/h ({modes} modes), peak gains:")
+    for name in names:
+        gain = np.asarray(report[f"{name}_gain"])
+        typer.echo(f"  {name:>18}: {gain.max():.4g} at {f[gain.argmax()]:.2f} Hz")

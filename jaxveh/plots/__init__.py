@@ -12,6 +12,7 @@ from ._chapter3 import (
     save as save,
 )
 from ._kinematics import (
+    plot_car_preview as plot_car_preview,
     plot_kinematic_gradients as plot_kinematic_gradients,
     plot_modal_coordinates as plot_modal_coordinates,
     plot_projection_matrices as plot_projection_matrices,

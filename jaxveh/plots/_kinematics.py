@@ -85,3 +85,33 @@ def plot_projection_matrices(pm, title: str = ""):
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+def plot_car_preview(report: dict, title: str = ""):
+    """Fig. 7.10: preview gains of the car, rigid and flexible, and of the chapter-3 model
+    (a :func:`jaxveh.analysis.preview_report`); the preview distance against the number of
+    modes and, when present, against each mode's stiffness multiplier."""
+    has_mu = "preview_distance_vs_mu_m" in report
+    fig, axes = figure(1, 3 if has_mu else 2, figsize=(16 if has_mu else 11, 4.5))
+    for label, r, style in (("14 dof flexible", report["flexible"], "-"), ("14 dof rigid", report["rigid"], "--"),
+                            ("chapter 3 flexible", report["chapter_3"]["flexible"], "-."),
+                            ("chapter 3 rigid", report["chapter_3"]["rigid"], ":")):
+        key = "gains_deg_per_m" if "gains_deg_per_m" in r else "gains"
+        axes[0].plot(r["distance_m"], r[key], style, label=label)
+    axes[0].set_xlabel("preview distance [m]")
+    axes[0].set_ylabel("Kp [deg/m]")
+    lp = report["preview_distance_by_modes_m"]
+    axes[1].plot(range(len(lp)), lp, "o-")
+    axes[1].set_xlabel("number of modes")
+    axes[1].set_ylabel("Lp [m]")
+    if has_mu:
+        for k, row in enumerate(report["preview_distance_vs_mu_m"]):
+            axes[2].semilogx(report["mu"], row, "o-", label=f"mode {k + 1}")
+        axes[2].set_xlabel("µ")
+        axes[2].set_ylabel("Lp [m]")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8)
+    fig.suptitle(title or f"TI-optimal preview at {report['speed_kmh']:g} km/h (Fig. 7.10)", fontsize=10)
+    return fig
