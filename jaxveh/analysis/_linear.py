@@ -250,8 +250,10 @@ def linear_tangent(car, tangent, speed: float = 50.0 / 3.6):
     ``tangent`` (a :class:`jaxveh.vehicle.CarParams` of tangents), by forward-mode autodiff
     through the trim (implicit function theorem) and the Jacobians."""
     _check_tangent(car, tangent)
-    with run_time_checks_off():
-        return _compiled_tangent(car, tangent, jnp.asarray(speed, jnp.float64))
+    # Traced with the run-time checks on, on purpose: their host callbacks keep this program
+    # (an 18 MB module) out of JAX's persistent cache, because loading it back from the
+    # cache segfaults (jax 0.10.2, CPU, reproducible); it compiles once per process instead.
+    return _compiled_tangent(car, tangent, jnp.asarray(speed, jnp.float64))
 
 
 def eigenvalue_sensitivities(car, tangent, speed: float = 50.0 / 3.6):
