@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from jaxveh._core import GRAVITY
+from jaxveh._core import GRAVITY, ParameterError
 from jaxveh.analysis import (
     WHEEL_PARAMETERS,
     gradient_table,
@@ -112,6 +112,10 @@ def test_modal_coordinates_depend_on_ay_and_mode_3_on_the_mass(car, kg):
     assert dep[2]["r_squared"] > 0.99
     masses = np.asarray([150.0, 250.0, 350.0])
     by_mass = np.asarray(modes_vs_sprung_mass(car, masses, ay_g=AY_REF_G, radius=RADIUS))
+    with pytest.raises(ParameterError, match="ay_g = 0.0"):
+        modes_vs_sprung_mass(car, masses, ay_g=0.0)
+    with pytest.raises(ParameterError, match="masses"):
+        modes_vs_sprung_mass(car, [-1.0])
     mode3 = by_mass[:, 2]
     assert mode3[2] > mode3[1] > mode3[0] > 0
     np.testing.assert_allclose(mode3[1], 0.5 * (mode3[0] + mode3[2]), atol=5e-2 * (mode3[2] - mode3[0]))

@@ -225,11 +225,10 @@ def kinematic_gradients(car, radius: float = 50.0) -> KinematicGradients:
     steps of 0.05 g): two compiled programs, the skid-pad's (shared) and this one's."""
     car = check_car(car)
     pad = skid_pad(car, radius, skid_pad_grid(AY_MAX_G, AY_STEP_G))
-    n = car.n_modes
     dmodes = pad.gradients["modes"]
     with run_time_checks_off():
         params, jac, grads, flex = _along_pad(car, pad.states.state.q, pad.states.rack, dmodes, pad.ay)
-    return KinematicGradients(radius=pad.radius, ay=pad.ay, ok=pad.ok, modes=pad.states.channels["modes"][:, :n],
+    return KinematicGradients(radius=pad.radius, ay=pad.ay, ok=pad.ok, modes=pad.states.channels["modes"],
                               modal_gradients=dmodes, deformation_gradients=jac, gradients=grads, flexible_part=flex,
                               parameters=params)
 
@@ -286,6 +285,8 @@ def modes_vs_sprung_mass(car, masses, ay_g: float = 0.3, radius: float = 50.0) -
     masses = np.asarray(masses, float)
     if masses.ndim != 1 or not np.all(masses > 0.0):
         raise ParameterError("masses must be a 1-D sequence of positive sprung masses (kg)")
+    if not ay_g > 0.0:
+        raise ParameterError(f"ay_g = {ay_g!r} is out of range: allowed > 0 (g, turning left on the skid-pad)")
     rows = []
     for m in masses:
         c = eqx.tree_at(lambda c: c.params.vehicle.sprung.mass, car, jnp.asarray(m))
