@@ -82,3 +82,10 @@ from ._root_locus import (
     root_locus as root_locus,
     root_locus_report as root_locus_report,
 )
+from ._simplifications import (
+    FREEZE_STEPS as FREEZE_STEPS,
+    SIMPLIFICATIONS as SIMPLIFICATIONS,
+    simplification_study as simplification_study,
+    table_7_2_step_steer as table_7_2_step_steer,
+    variant_car as variant_car,
+)

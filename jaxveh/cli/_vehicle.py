@@ -380,3 +380,55 @@ def frequency_response(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
     for name in names:
         gain = np.asarray(report[f"{name}_gain"])
         typer.echo(f"  {name:>18}: {gain.max():.4g} at {f[gain.argmax()]:.2f} Hz")
+
+
+@vehicle_app.command("simplifications")
+def simplifications(vehicle: Path = VehicleOpt, modes: int = ModesOpt,
+                    variants: str = typer.Option(None, "--variants",
+                                                 help="comma-separated variants (default: all of Table 7.2's)"),
+                    freeze_steps: int = typer.Option(5, "--freeze-steps",
+                                                     help="steps the projection matrices are held (>= 1)"),
+                    duration: float = typer.Option(5.0, "--duration", help="length of the step steer, s (> 0.6)"),
+                    rtol: float = typer.Option(1e-4, "--rtol", help="relative tolerance of the integration"),
+                    rigid: bool = typer.Option(True, "--rigid/--no-rigid", help="add the rigid-chassis car's row"),
+                    as_json: bool = JsonOpt, out: Path = OutOpt) -> None:
+    """Table 7.2 and section 7.6 on the library car: the step steer of Fig. 7.6 with the
+    complete flexible model and each simplification (constant mass matrix, neglected Gr/Ge,
+    S c, S b, centre-of-mass shift, projection matrices held for k steps): steps, wall time
+    and each channel's largest deviation from the complete model."""
+    from ..analysis import SIMPLIFICATIONS, simplification_study, table_7_2_step_steer
+    from ._simulate import _compilation_cache
+
+    _compilation_cache()
+    chosen = tuple(SIMPLIFICATIONS) if variants is None else tuple(v.strip() for v in variants.split(","))
+    unknown = [v for v in chosen if v not in SIMPLIFICATIONS]
+    if unknown or not chosen:
+        fail(f"--variants must name some of {', '.join(SIMPLIFICATIONS)}; unknown: {', '.join(unknown) or '(none)'}")
+    if modes < 1:
+        fail(f"--modes must be >= 1 (the simplifications concern the flexible chassis), got {modes}")
+    if freeze_steps < 1:
+        fail(f"--freeze-steps must be >= 1, got {freeze_steps}")
+    if not duration > 0.6:
+        fail(f"--duration must be > 0.6 s (the step rises at 0.5-0.6 s), got {duration:g}")
+    if not 0.0 < rtol < 1.0:
+        fail(f"--rtol must be in (0, 1), got {rtol:g}")
+    try:
+        report = simplification_study(_car(vehicle, modes), _car(vehicle, 0) if rigid else None, chosen,
+                                      freeze_steps, table_7_2_step_steer(duration), rtol)
+    except (*_errors(), RuntimeError) as e:
+        fail(str(e))
+    if out is not None:
+        from .. import plots
+
+        out = Path(out)
+        write_json(report, out / "simplifications.json")
+        plots.save(plots.plot_simplifications(report), out / "simplifications.png")
+    if as_json:
+        emit_json(report)
+        return
+    typer.echo(f"{'variant':<20}{'steps':>7}{'wall s':>9}{'yaw rate dev.':>15}{'ay dev.':>10}{'modes dev.':>12}")
+    for name, row in report["variants"].items():
+        dev = row.get("relative_deviation", {})
+        cols = "".join(f"{dev[k]:>{w}.1e}" if k in dev else f"{'-':>{w}}"
+                       for k, w in (("yaw_rate", 15), ("ay", 10), ("modes", 12)))
+        typer.echo(f"{name:<20}{row['steps']:>7}{row['wall_s']:>9.2f}{cols}")

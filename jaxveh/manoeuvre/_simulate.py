@@ -124,7 +124,8 @@ def _driving(car, manoeuvre: Manoeuvre, trim_rack, pose: int) -> _Driving:
                     lambda t, aux: aux[k])
 
 
-def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
+def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps):
+    del freeze_steps  # refused for the fast car, which has no projection
     driving = _driving(car, manoeuvre, trim.rack, 0)
     law, elements = driving.law, driving.elements
     s0 = FastState(trim.state.q, trim.state.u, jnp.concatenate([trim.state.aux, driving.aux0]))
@@ -194,7 +195,7 @@ def _imex_terms(field, s0: FastState, n_modes: int):
     return diffrax.MultiTerm(diffrax.ODETerm(explicit), diffrax.ODETerm(implicit))
 
 
-def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
+def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps):
     c = car.system.body_names.index("chassis")
     q_c = car.system.q_offsets[c]  # the chassis's x, y, z, yaw, pitch, roll
     chassis = slice(q_c, q_c + 6)
@@ -216,23 +217,33 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps):
     sim = mb.simulate(car.system, system_params(car), trim.static.q, trim.z, 0.0, manoeuvre.duration, ts,
                       inputs=law, elements=elements, aux0=aux0, outputs=outputs, solver=_solver(solver),
                       rtol=rtol, atol=atol, dt0=FIRST_STEP, max_steps=max_steps,
-                      implicit_modes=solver == "kencarp4", throw=False,
+                      implicit_modes=solver == "kencarp4", freeze_steps=freeze_steps, throw=False,
                       events={"rollover": lambda t, st: rolled(st), "spin": lambda t, st: spun(st)})
     event = jnp.where(sim.status == 1, _event_code(rolled(sim.final), spun(sim.final)), 0)
     return sim.outputs, dict(sim.stats) | {"event": event, "valid": sim.valid}, sim.status
 
 
 def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, solver: str = "tsit5", rtol=1e-4,
-                       atol=1e-6, max_steps: int = 100_000):
+                       atol=1e-6, max_steps: int = 100_000, freeze_steps: int = 0):
     """``(channels, stats, status)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
     in ``form`` ("fast" or "library"), from ``trim`` (default: :func:`straight_trim`): a
     pure function of the car and the manoeuvre (jit, vmap and grad through it; reverse
     mode uses Diffrax's recursive checkpointing). ``stats``: Diffrax's counts, ``event``
     (0 or the 1-based index into :data:`EVENTS`) and ``valid`` (save times reached);
-    ``status``: 0 completed, 1 stopped by an event, 2 solver failure."""
+    ``status``: 0 completed, 1 stopped by an event, 2 solver failure. ``freeze_steps``
+    (library form): hold the projection matrices for that many steps
+    (:class:`jaxveh.multibody.ProjectedSolver`; 0: exact)."""
     run = _fast if check_form(form) == "fast" else _library
+    _check_freeze_steps(freeze_steps, form)
     trim = straight_trim(car, manoeuvre.speed, form) if trim is None else trim
-    return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps)
+    return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps)
+
+
+def _check_freeze_steps(freeze_steps, form: str) -> None:
+    if not (isinstance(freeze_steps, int) and freeze_steps >= 0):
+        raise ParameterError(f"freeze_steps = {freeze_steps!r} is out of range: allowed integers >= 0 (0: exact)")
+    if freeze_steps and form != "library":
+        raise ParameterError(f"freeze_steps = {freeze_steps} needs form = 'library' (the fast car has no projection)")
 
 
 def straight_trim(car, speed, form: str):
@@ -267,7 +278,8 @@ def save_times(manoeuvre: Manoeuvre, points: int):
 
 
 def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "tsit5",
-             rtol: float = 1e-4, atol: float | None = None, max_steps: int = 100_000, throw: bool = True) -> CarRun:
+             rtol: float = 1e-4, atol: float | None = None, max_steps: int = 100_000, throw: bool = True,
+             freeze_steps: int = 0) -> CarRun:
     """Run ``manoeuvre`` on ``car`` (compiled once per car structure and solver) and return a
     :class:`CarRun` with ``points`` save times. ``form``: "fast" or "library" (default: the
     car's own, ``car.form``). ``rtol``/``atol``: the PID step-size controller's tolerances
@@ -275,6 +287,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     A run stops early when the car rolls over or spins (:data:`EVENTS`; ``status`` 1,
     ``stop_reason`` names the event and its time). A failed solve raises ``RuntimeError``
     naming the last time reached (``throw=False``: the run is returned with ``status`` 2).
+    ``freeze_steps`` (library form, Table 7.2 studies): see :func:`manoeuvre_channels`.
     After a stop the channels hold their last reached values (``valid`` marks the save
     times reached)."""
     form = check_form(car.form if form is None else form)
@@ -287,6 +300,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     if not atol > 0.0:
         raise ParameterError(f"atol = {atol!r} is out of range: allowed > 0")
     _check_steering(manoeuvre)
+    _check_freeze_steps(freeze_steps, form)
     ts = save_times(manoeuvre, points)
     check_car(car)  # here, so that the programs need no run-time checks (the disk cache keeps them)
     start = time.perf_counter()
@@ -298,7 +312,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
         # tolerances as arrays: one compilation serves every tolerance
         channels, stats, status = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
                                             rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
-                                            max_steps=max_steps)
+                                            max_steps=max_steps, freeze_steps=freeze_steps)
         channels = jax.block_until_ready(channels)
     wall = time.perf_counter() - start
     status, valid = int(status), np.asarray(stats["valid"])

@@ -17,17 +17,29 @@ from ._rotations import skew
 
 
 class FlexOptions(eqx.Module):
-    """Simplifications of the flexible-body equations (thesis Table 7.2); static flags.
+    """Simplifications of the equations of motion (thesis section 7.6, Table 7.2); static flags.
+
+    Flexible bodies (section 7.6.1):
 
     - ``constant_mass``: use the mass matrix of the undeformed body, ``M(p) = M(0)``;
     - ``neglect_gyroscopic``: drop the ``Gr`` / ``Ge`` terms of eq. (5.45), i.e. the terms
       bilinear in the angular and the modal velocities of the rotational and elastic rows;
-    - ``neglect_c``: drop the deformation shift of the centre of mass ``c1 = Ct p / m``.
+    - ``neglect_com_shift``: drop the deformation shift of the centre of mass ``c1 = Ct p / m``.
+
+    Coordinate reduction (section 7.6.2):
+
+    - ``neglect_sc``: drop ``S c``, the constraint-acceleration term of eq. (5.58)
+      (Table 7.2's "neglect vector c"): ``y_dot = R z_dot``;
+    - ``neglect_sb``: drop ``S b`` of eq. (5.55), ``y = R z``: a rheonomic input (the rack)
+      then moves the dependent coordinates only through the position correction after each
+      step, as in the thesis.
     """
 
     constant_mass: bool = eqx.field(static=True, default=False)
     neglect_gyroscopic: bool = eqx.field(static=True, default=False)
-    neglect_c: bool = eqx.field(static=True, default=False)
+    neglect_com_shift: bool = eqx.field(static=True, default=False)
+    neglect_sc: bool = eqx.field(static=True, default=False)
+    neglect_sb: bool = eqx.field(static=True, default=False)
 
 
 class AbstractBody(eqx.Module):
@@ -124,7 +136,7 @@ class FlexibleBody(AbstractBody):
         """Mass matrix of eq. (5.37) at modal coordinates ``p`` (first order in ``p``), from
         the FE module's one implementation of the invariants' formulas."""
         p = jnp.zeros_like(p) if options.constant_mass else p
-        return self.modal.mass_matrix(p, neglect_c=options.neglect_c)
+        return self.modal.mass_matrix(p, neglect_c=options.neglect_com_shift)
 
     def _com_moment(self, p):
         """``m c(p) = m c0 + Ct p`` (kg m, body axes)."""
@@ -133,7 +145,7 @@ class FlexibleBody(AbstractBody):
 
     def gravity(self, g_body, p, options: FlexOptions):
         """Generalised gravity force of eq. (5.43) with ``g_body`` in body axes (m/s^2)."""
-        return self.modal.gravity_forces(p, g_body, neglect_c=options.neglect_c)
+        return self.modal.gravity_forces(p, g_body, neglect_c=options.neglect_com_shift)
 
     def elastic(self, p, p_dot):
         """Elastic and damping generalised forces ``-(K p + D p_dot)`` (eq. 5.44)."""

@@ -145,6 +145,14 @@ def _projection(system, params, q, u, u_dot, kappa) -> Projection:
     return Projection(phi=phi, phi_y=phi_y, T=t_mat, R=r, Sb=_scatter(system, sol[:, 0], zeros), lu=lu)
 
 
+def _refreshed(system, params, frozen: Projection, q, u, u_dot, kappa) -> Projection:
+    """``frozen`` with today's residuals ``Phi`` and particular solution ``S b`` (through the
+    frozen LU factors): only ``Phi`` and its input rate are evaluated, not the Jacobians."""
+    phi, phi_t = jax.jvp(lambda uu: constraints(system, params, q, uu), (u,), (u_dot,))
+    sb = solve_s(system, frozen.lu, -phi_t - kappa * phi)
+    return Projection(phi=phi, phi_y=frozen.phi_y, T=frozen.T, R=frozen.R, Sb=sb, lu=frozen.lu)
+
+
 def _velocity_constraint(system, params, y, kappa):
     """``h(q, u, w) = Phi_q B T y + Phi_u w + kappa Phi`` with ``y`` held fixed (``w`` the input rates)."""
 
@@ -200,6 +208,7 @@ def dynamics(
     kappa=0.0,
     elements: tuple = (),
     aux=None,
+    frozen: Projection | None = None,
 ) -> Dynamics:
     """Reduced equations of motion (eq. 5.61) at ``(q, z, aux, t)``.
 
@@ -207,13 +216,19 @@ def dynamics(
     :class:`Kinematics`; ``aux`` their auxiliary states. ``external(q, v, t, args)`` returns
     further applied generalised forces in ``v`` coordinates (use :func:`point_force` /
     :func:`body_torque`); gravity is built in (``params.gravity``). ``inputs``: a function
-    of time or an input law (:mod:`._inputs`).
+    of time or an input law (:mod:`._inputs`). ``frozen``: a :class:`Projection` computed at
+    an earlier state whose ``T``, ``Phi_q B T``, ``R`` and LU factors are used instead of
+    today's (see :class:`ProjectedSolver`'s ``freeze_steps``); ``Phi`` and ``S b`` are
+    always today's. ``system.options`` may drop ``S b`` and ``S c`` (Table 7.2).
     """
     t = jnp.asarray(t, q.dtype)
     aux = _empty(q.dtype) if aux is None else aux
     law = as_inputs(inputs)
     u, u_dot = input_state(system, law, t, q, aux)
-    proj = _projection(system, params, q, u, u_dot, kappa)
+    proj = _projection(system, params, q, u, u_dot, kappa) if frozen is None else _refreshed(
+        system, params, frozen, q, u, u_dot, kappa)
+    if system.options.neglect_sb:
+        proj = eqx.tree_at(lambda p: p.Sb, proj, jnp.zeros_like(proj.Sb))
     y = proj.R @ z + proj.Sb
     poses = body_poses(system, params, q)
     vs = body_velocities(system, params, q, y, poses)
@@ -232,7 +247,7 @@ def dynamics(
         u_ddot = u_dot
     h = _velocity_constraint(system, params, y, kappa)
     c = -jax.jvp(h, (q, u, u_dot), (q_dot, u_dot, u_ddot))[1]
-    sc = solve_s(system, proj.lu, c)
+    sc = jnp.zeros_like(y) if system.options.neglect_sc else solve_s(system, proj.lu, c)
     t_dot_y = jax.jvp(lambda qq: jnp.concatenate(body_velocities(system, params, qq, y)), (q,), (q_dot,))[1]
     a0 = proj.T @ sc + t_dot_y  # body accelerations at z_dot = 0
     tr = proj.T @ proj.R

@@ -246,11 +246,18 @@ class ProjectedSolver(diffrax.AbstractAdaptiveSolver, diffrax.AbstractWrappedSol
     section 5.6). ``z`` and ``aux`` need no correction: ``y = R z + S b`` is recomputed from
     ``z`` at the corrected ``q``, so the velocity constraints hold exactly. One Newton
     iteration per step suffices: the step starts on the manifold, the residual after a step
-    is of the order of the local error, and Newton squares it."""
+    is of the order of the local error, and Newton squares it.
+
+    ``freeze_steps = k > 0`` (a simplification in the spirit of thesis section 7.6.2): the
+    projection matrices (``T``, ``Phi_q B T``, ``R`` and the LU factors that give ``S``) are
+    computed at the start of every k-th attempted step and held for all stages of the next
+    k steps; the vector field gets them as a fifth element of ``args``. ``0``: recomputed at
+    every evaluation (exact)."""
 
     solver: diffrax.AbstractSolver
     system: System = eqx.field(static=True)
     iterations: int = eqx.field(static=True, default=1)
+    freeze_steps: int = eqx.field(static=True, default=0)
 
     @property
     def term_structure(self):
@@ -274,13 +281,31 @@ class ProjectedSolver(diffrax.AbstractAdaptiveSolver, diffrax.AbstractWrappedSol
     def error_order(self, terms):
         return self.solver.error_order(terms)
 
+    def _projection(self, args, t, y):
+        params, inputs = args[0], args[1]
+        return projection(self.system, params, y.q, t, inputs, 0.0, y.aux)
+
     def init(self, terms, t0, t1, y0, args):
-        return self.solver.init(terms, t0, t1, y0, args)
+        if not self.freeze_steps:
+            return self.solver.init(terms, t0, t1, y0, args)
+        frozen = self._projection(args, t0, y0)
+        inner = self.solver.init(terms, t0, t1, y0, (*args, frozen))
+        return inner, frozen, jnp.zeros((), jnp.int32)
 
     def step(self, terms, t0, t1, y0, args, solver_state, made_jump):
-        y1, y_error, dense_info, solver_state, result = self.solver.step(
-            terms, t0, t1, y0, args, solver_state, made_jump
-        )
+        if self.freeze_steps:
+            inner, frozen, count = solver_state
+            frozen = jax.lax.cond(
+                count % self.freeze_steps == 0, lambda: self._projection(args, t0, y0), lambda: frozen
+            )
+            y1, y_error, dense_info, inner, result = self.solver.step(
+                terms, t0, t1, y0, (*args, frozen), inner, made_jump
+            )
+            solver_state = (inner, frozen, count + 1)
+        else:
+            y1, y_error, dense_info, solver_state, result = self.solver.step(
+                terms, t0, t1, y0, args, solver_state, made_jump
+            )
         params, inputs = args[0], args[1]
         q1 = project_coordinates(self.system, params, y1.q, t1, inputs, self.iterations, y1.aux)
         y1 = State(q1, y1.z, y1.aux)
@@ -323,11 +348,13 @@ class Simulation(eqx.Module):
 
 
 def vector_field(system: System, kappa=DEFAULT_KAPPA, elements: tuple = ()):
-    """Diffrax-ready vector field ``f(t, State, (params, inputs, external, args))``."""
+    """Diffrax-ready vector field ``f(t, State, (params, inputs, external, args[, frozen]))``
+    (``frozen``: held projection matrices, see :class:`ProjectedSolver`)."""
 
     def f(t, state, args):
-        params, inputs, external, ext_args = args
-        dyn = dynamics(system, params, state.q, state.z, t, inputs, external, ext_args, kappa, elements, state.aux)
+        params, inputs, external, ext_args, *frozen = args
+        dyn = dynamics(system, params, state.q, state.z, t, inputs, external, ext_args, kappa, elements, state.aux,
+                       frozen[0] if frozen else None)
         return State(dyn.q_dot, dyn.z_dot, dyn.aux_dot)
 
     return f
@@ -398,6 +425,7 @@ def simulate(
     adjoint=None,
     project: bool = True,
     implicit_modes: bool = False,
+    freeze_steps: int = 0,
     progress: bool = False,
     throw: bool = True,
 ) -> Simulation:
@@ -417,8 +445,9 @@ def simulate(
     elastic and damping forces implicitly and the rest explicitly (IMEX, :mod:`._imex`);
     ``solver`` then defaults to ``KenCarp4`` with a Newton root finder and must be an IMEX
     solver. For stiff chassis modes, whose explicit step is bounded by stability (1.6-1.9x
-    faster on the vehicle benchmark at rtol 1e-3). ``progress`` prints a text progress
-    meter. With ``throw``
+    faster on the vehicle benchmark at rtol 1e-3). ``freeze_steps = k``: hold the projection
+    matrices for k steps (see :class:`ProjectedSolver`; needs ``project``). ``progress``
+    prints a text progress meter. With ``throw``
     a solver failure raises (Diffrax's message says when and why); without, the result
     says it in ``stop_reason`` and holds the last valid state. Pure: ``jax.grad`` and
     ``jax.vmap`` go through it.
@@ -447,8 +476,12 @@ def simulate(
     else:
         terms = diffrax.ODETerm(field)
         solver = diffrax.Tsit5() if solver is None else solver
+    if not (isinstance(freeze_steps, int) and freeze_steps >= 0):
+        raise ValueError(f"freeze_steps = {freeze_steps!r} is out of range: allowed integers >= 0 (0: exact)")
+    if freeze_steps and not (project and system.n_constraints):
+        raise ValueError("freeze_steps needs project=True and a system with constraints (it holds R and S)")
     if project and system.n_constraints:
-        solver = ProjectedSolver(solver, system)
+        solver = ProjectedSolver(solver, system, freeze_steps=freeze_steps)
     event = _event(events)
     sol = diffrax.diffeqsolve(
         terms,

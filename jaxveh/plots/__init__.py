@@ -16,6 +16,7 @@ from ._kinematics import (
     plot_kinematic_gradients as plot_kinematic_gradients,
     plot_modal_coordinates as plot_modal_coordinates,
     plot_projection_matrices as plot_projection_matrices,
+    plot_simplifications as plot_simplifications,
 )
 from ._manoeuvres import (
     plot_four_post as plot_four_post,

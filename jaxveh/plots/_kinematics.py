@@ -1,4 +1,5 @@
-"""Figures of the chassis's effect on the suspension kinematics (thesis Figs 7.1, 7.3, 7.4)."""
+"""Chapter-7 figures of the car: the chassis's effect on the suspension kinematics (thesis Figs
+7.1, 7.3, 7.4), optimal preview (Fig. 7.10) and the simplifications of Table 7.2."""
 
 import numpy as np
 
@@ -114,4 +115,33 @@ def plot_car_preview(report: dict, title: str = ""):
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=8)
     fig.suptitle(title or f"TI-optimal preview at {report['speed_kmh']:g} km/h (Fig. 7.10)", fontsize=10)
+    return fig
+
+
+def plot_simplifications(report: dict, channels=("yaw_rate", "ay", "roll", "fz", "modes"), title: str = ""):
+    """Table 7.2 as a figure: (a) wall time and steps per variant, (b) each variant's largest
+    deviation from the complete flexible model relative to its largest value, per channel
+    (log scale)."""
+    rows = report["variants"]
+    names = list(rows)
+    fig, (ax_cost, ax_dev) = figure(1, 2, figsize=(12, 4.5))
+    x = np.arange(len(names))
+    ax_cost.bar(x, [rows[n]["wall_s"] for n in names], color="tab:blue")
+    ax_cost.set(xticks=x, ylabel="wall time [s] (after compilation)")
+    ax_cost.set_xticklabels(names, rotation=30, ha="right", fontsize=8)
+    steps = ax_cost.twinx()
+    steps.plot(x, [rows[n]["steps"] for n in names], "o", color="tab:red")
+    steps.set_ylabel("steps", color="tab:red")
+    simplified = [n for n in names if n not in ("complete", "rigid")]
+    width = 0.8 / max(len(channels), 1)
+    for k, ch in enumerate(channels):
+        dev = [max(rows[n]["relative_deviation"][ch], 1e-16) for n in simplified]
+        ax_dev.bar(np.arange(len(simplified)) + (k - (len(channels) - 1) / 2) * width, dev, width, label=ch)
+    ax_dev.set(yscale="log", xticks=np.arange(len(simplified)), ylabel="max |deviation| / max |complete|")
+    ax_dev.set_xticklabels(simplified, rotation=30, ha="right", fontsize=8)
+    ax_dev.legend(fontsize=7)
+    ax_dev.grid(True, axis="y", alpha=0.3)
+    m = report["manoeuvre"]
+    fig.suptitle(title or f"step steer {m['speed_kmh']:.0f} km/h, {m['steering_wheel_deg']:g} deg, "
+                 f"{m['duration_s']:g} s; {report['modes']} modes, rtol {report['rtol']:g}")
     return fig
