@@ -7,6 +7,7 @@ from ._chassis import app as chassis_app
 from ._multibody import app as multibody_app
 from ._run import run as run_command
 from ._simulate import app as simulate_app
+from ._study import sweep as sweep_command
 from ._tyre import app as tyre_app
 from ._vehicle import rig_app, vehicle_app
 
@@ -16,6 +17,7 @@ app = typer.Typer(
     add_completion=False,
 )
 app.command("run")(run_command)
+app.command("sweep")(sweep_command)
 app.add_typer(analytic_app, name="analytic")
 app.add_typer(tyre_app, name="tyre")
 app.add_typer(chassis_app, name="chassis")
