@@ -118,7 +118,7 @@ def bench_options():
         ("full", mb.FlexOptions()),
         ("constant mass matrix", mb.FlexOptions(constant_mass=True)),
         ("neglect Gr/Ge", mb.FlexOptions(neglect_gyroscopic=True)),
-        ("neglect c", mb.FlexOptions(neglect_com_shift=True)),
+        ("neglect c shift", mb.FlexOptions(neglect_com_shift=True)),
         ("all three", mb.FlexOptions(True, True, True)),
     ):
         s = system.with_options(options)
@@ -166,7 +166,7 @@ def bench_chassis_options():
         ("full", mb.FlexOptions()),
         ("constant mass matrix", mb.FlexOptions(constant_mass=True)),
         ("neglect Gr/Ge", mb.FlexOptions(neglect_gyroscopic=True)),
-        ("neglect c", mb.FlexOptions(neglect_com_shift=True)),
+        ("neglect c shift", mb.FlexOptions(neglect_com_shift=True)),
     ):
         s = system.with_options(options)
         run = jax.jit(lambda p, s=s: mb.simulate(s, p, q0, z0, 0.0, 0.2, ts=ts, rtol=1e-9, atol=1e-12))

@@ -8,14 +8,19 @@ module ends (its module-scoped fixtures, a compiled car, are torn down first) an
 long module, after any test that leaves the process above half the limit (later tests of
 that module then compile again: slower, never wrong).
 
-Compiled executables also go to a persistent compilation cache (``.pytest_cache/jax``,
-entries that took over a second to compile): a later module, worker or run that compiles
-the same program (the car's static set-up, say) loads it instead. Programs with run-time
+Compiled executables also go to a persistent compilation cache (entries that took over a
+second to compile): a later module, worker or run that compiles the same program (the car's
+static set-up, say) loads it instead. It lives outside the checkout, in
+``~/.cache/jaxveh/pytest-jax`` (``$JAXVEH_TEST_CACHE`` moves it), so that a fresh clone on
+a machine that ran the suite before skips XLA's compilation of every unchanged program
+(tracing still runs); JAX keys each entry by the program and the JAX version, so a changed
+program simply misses. Least recently used entries beyond 8 GB are dropped. Programs with run-time
 checks (host callbacks) are not stored; the car's manoeuvre and steady-state programs are
 traced without them (``jaxveh._core.run_time_checks_off``), so they are.
 """
 
 import gc
+import os
 from pathlib import Path
 
 import jax
@@ -26,7 +31,9 @@ import jaxveh  # noqa: F401  (enables float64)
 jax.config.update("jax_enable_x64", True)
 jax.config.update("jax_numpy_dtype_promotion", "strict")
 jax.config.update("jax_numpy_rank_promotion", "raise")
-jax.config.update("jax_compilation_cache_dir", str(Path(__file__).resolve().parents[1] / ".pytest_cache" / "jax"))
+_CACHE = os.environ.get("JAXVEH_TEST_CACHE") or str(Path.home() / ".cache" / "jaxveh" / "pytest-jax")
+jax.config.update("jax_compilation_cache_dir", _CACHE)
+jax.config.update("jax_compilation_cache_max_size", 8 * 2**30)
 jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 _MAPS, _MAX_MAPS = Path("/proc/self/maps"), Path("/proc/sys/vm/max_map_count")

@@ -116,5 +116,6 @@ def simplification_study(car, rigid=None, variants=tuple(SIMPLIFICATIONS), freez
         rows[name] = row
     return {"variants": rows, "flexibility_effect": effect, "freeze_steps": freeze_steps, "rtol": rtol,
             "modes": car.n_modes, "units": {k: run.units[k] for k in base},
-            "manoeuvre": {"speed_kmh": float(manoeuvre.speed) * 3.6, "steering_wheel_deg": float(np.rad2deg(manoeuvre.steering.amplitude)),
+            "manoeuvre": {"speed_kmh": float(manoeuvre.speed) * 3.6,
+                          "steering_wheel_deg": float(np.rad2deg(manoeuvre.steering.amplitude)),
                           "duration_s": float(manoeuvre.duration)}}
