@@ -59,5 +59,6 @@ from ._steady import (
     SkidPad as SkidPad,
     SteadyCornering as SteadyCornering,
     skid_pad as skid_pad,
+    skid_pad_core as skid_pad_core,
     steady_state as steady_state,
 )
