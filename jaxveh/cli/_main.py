@@ -5,6 +5,7 @@ import typer
 from ._analytic import app as analytic_app
 from ._chassis import app as chassis_app
 from ._multibody import app as multibody_app
+from ._optimise import optimise as optimise_command
 from ._run import run as run_command
 from ._simulate import app as simulate_app
 from ._study import sweep as sweep_command
@@ -17,6 +18,7 @@ app = typer.Typer(
     add_completion=False,
 )
 app.command("run")(run_command)
+app.command("optimise")(optimise_command)
 app.command("sweep")(sweep_command)
 app.add_typer(analytic_app, name="analytic")
 app.add_typer(tyre_app, name="tyre")

@@ -1,0 +1,450 @@
+"""Objectives of the flexible car for design optimisation: pure, differentiable scalar
+functions of a :class:`jaxveh.vehicle.Car` (its numbers in ``car.params``), registered by
+name in :data:`OBJECTIVES` so that study files can name them.
+
+Each objective wraps what jaxveh computes; none re-derives the physics:
+
+- skid-pad quantities (understeer gradient, steering sensitivity, roll, camber and rear
+  steer gradients) from one steady state on a circle, :func:`jaxveh.manoeuvre.skid_pad_core`
+  (Newton by Optimistix; the gradients with respect to ay come from the same linear solve,
+  the derivatives with respect to the car's parameters by the implicit function theorem);
+- χ at low ay from the left and right steady turns, :func:`jaxveh.analysis.load_transfer_core`;
+- the first coupled chassis mode's frequency and damping ratio from the exact linearisation
+  about straight running (:func:`jaxveh.manoeuvre.straight_trim`,
+  :func:`jaxveh.analysis.linear_field`): the eigenvalue of the state matrix whose eigenvector
+  matches (largest MAC) a reference eigenvector, the mode that
+  :func:`jaxveh.analysis.first_chassis_mode` identifies on the base car's coupling root
+  locus (:func:`first_mode_reference`); its derivative is the first-order perturbation
+  ``d lambda = w^H dA v / (w^H v)`` (left and right eigenvectors), as
+  :func:`jaxveh.analysis.eigenvalue_sensitivities` computes it, here as a JAX rule so that
+  forward and reverse mode both work;
+- the chassis frame's mass and torsional stiffness (FE, :mod:`jaxveh.fe`): functions of a
+  :class:`jaxveh.fe.Frame` (:data:`FRAME_OBJECTIVES`), not of ``CarParams``, whose chassis is
+  the frame's modal reduction.
+
+A steady state or trim that does not converge makes the objective NaN (the caller reports
+it; :func:`optimise.optimise_study` raises :class:`optimise.OptimisationError`).
+
+Objectives sharing one computation (the skid-pad point at one ay and radius, the load
+transfer at one pair of ay) are evaluated once by :func:`objective_values`.
+"""
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+import jaxveh.fe as fe
+from jaxveh import GRAVITY, ParameterError
+from jaxveh.analysis import (
+    LOW_AY_PAIR_G,
+    SKID_PAD_RADIUS,
+    first_chassis_mode,
+    linear_field,
+    load_transfer_core,
+    root_locus,
+)
+from jaxveh.manoeuvre import skid_pad_core, straight_trim
+from jaxveh.vehicle import CORNERS, car_rates, installation_ratios
+
+#: Lateral acceleration (g) of the skid-pad objectives by default: the linear range.
+DEFAULT_AY_G = 0.05
+#: Speed (km/h) of the linearisation of the mode objectives by default (the root loci's).
+DEFAULT_SPEED_KMH = 50.0
+#: Damped frequencies below this (Hz) are not vibration modes (the neutral and real modes).
+MIN_MODE_HZ = 1e-3
+
+
+# ---- the roll stiffness distribution as a traced design variable ---------------------------
+
+
+class RollRateCoefficients(NamedTuple):
+    """What λ = kF / (kF + kR) needs of the car (N m/rad): the springs' roll stiffness per
+    axle ``springs_front``/``springs_rear``, the bar roll stiffness per unit bar rate
+    ``(dθ/dz t)^2`` per axle ``bar_front``/``bar_rear`` (m^2/rad... per N m/rad of bar) and
+    the car's total roll stiffness ``total``; from :func:`jaxveh.vehicle.car_rates` and
+    :func:`jaxveh.vehicle.installation_ratios` (NumPy set-up, not traceable)."""
+
+    springs_front: jax.Array
+    springs_rear: jax.Array
+    bar_front: jax.Array
+    bar_rear: jax.Array
+    total: jax.Array
+
+
+def roll_rate_coefficients(car) -> RollRateCoefficients:
+    """:class:`RollRateCoefficients` of ``car`` (eager: the rates are computed from quarter
+    cars built in NumPy)."""
+    rates = car_rates(car)
+    f, r = rates["front"], rates["rear"]
+    v = car.params.vehicle
+    return RollRateCoefficients(
+        springs_front=jnp.asarray(f.roll_stiffness_springs),
+        springs_rear=jnp.asarray(r.roll_stiffness_springs),
+        bar_front=jnp.asarray((installation_ratios("front", v).rocker * v.track_front) ** 2),
+        bar_rear=jnp.asarray((installation_ratios("rear", v).rocker * v.track_rear) ** 2),
+        total=jnp.asarray(f.roll_stiffness + r.roll_stiffness),
+    )
+
+
+def arb_rates_for_lambda(coefficients: RollRateCoefficients, lam):
+    """Anti-roll-bar rates (N m/rad of bar twist, front and rear) for the roll stiffness
+    distribution ``lam`` in (0, 1): :func:`jaxveh.analysis.arb_rates_for_distribution`'s
+    rule (total roll stiffness kept while both bars stay >= 0, beyond that the softer axle's
+    bar 0 and the other raised) in traceable form, with the car's coefficients computed
+    beforehand (:func:`roll_rate_coefficients`).
+
+    ``arb_rates_for_distribution`` checks λ with NumPy and computes the car's rates from
+    quarter cars built in NumPy, so neither can be traced; this is its formula on the
+    coefficients, tested equal to it. The coefficients depend on the springs, the
+    geometry and the bars of the base car: a study that varies those together with λ is
+    refused (:func:`optimise.load_optimisation_study`)."""
+    c = coefficients
+    lam = jnp.asarray(lam, jnp.float64)
+    k_front = jnp.maximum(lam * c.total, c.springs_front)
+    k_rear = jnp.maximum((1.0 - lam) * c.total, c.springs_rear)
+    k_front = jnp.maximum(k_front, lam / (1.0 - lam) * k_rear)
+    k_rear = jnp.maximum(k_rear, (1.0 - lam) / lam * k_front)
+    return jnp.stack([(k_front - c.springs_front) / c.bar_front, (k_rear - c.springs_rear) / c.bar_rear], axis=-1)
+
+
+# ---- the computations objectives share -------------------------------------------------------
+
+
+def _nan_unless(ok, value):
+    return jnp.where(ok, value, jnp.nan)
+
+
+def skid_pad_point(car, ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
+    """The steady state on a circle of ``radius`` (m) at ``ay_g`` (g), turning left, as a
+    one-point :class:`jaxveh.manoeuvre.SkidPad` (pure; differentiable)."""
+    return skid_pad_core(car, jnp.asarray(radius, jnp.float64), jnp.reshape(jnp.asarray(ay_g * GRAVITY), (1,)))
+
+
+def _corner_index(corner: str) -> int:
+    if corner not in CORNERS:
+        raise ParameterError(f"corner = {corner!r} is not allowed: one of {', '.join(CORNERS)}")
+    return CORNERS.index(corner)
+
+
+def _ku(pad):
+    return _nan_unless(pad.ok[0], pad.understeer_gradient[0])
+
+
+def _steering_sensitivity(pad):
+    return 1.0 / _ku(pad)
+
+
+def _roll_gradient(pad):
+    return _nan_unless(pad.ok[0], pad.gradients["roll"][0] * GRAVITY)
+
+
+def _camber_gradient(pad, corner="front_left"):
+    return _nan_unless(pad.ok[0], pad.gradients["camber"][0, _corner_index(corner)] * GRAVITY)
+
+
+def _rear_steer_gradient(pad, corner="rear_left"):
+    if not corner.startswith("rear"):
+        raise ParameterError(f"corner = {corner!r} is not allowed: rear_left or rear_right (the front wheels steer)")
+    return _nan_unless(pad.ok[0], pad.gradients["road_wheel_angle"][0, _corner_index(corner)] * GRAVITY)
+
+
+def understeer_gradient(car, ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
+    """Understeer gradient ku = d delta / d ay (deg/g) at ``ay_g`` (g) on ``radius`` (m):
+    :attr:`jaxveh.manoeuvre.SkidPad.understeer_gradient`, delta the mean front road-wheel
+    angle; negative: oversteer. NaN without a steady state."""
+    return _ku(skid_pad_point(car, ay_g, radius))
+
+
+def steering_sensitivity(car, ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
+    """Steering sensitivity 1 / ku (g/deg) at ``ay_g`` (g) on ``radius`` (m), as
+    ``jaxveh simulate skid-pad`` reports it (the thesis's Fig. 7.5b); infinite at neutral
+    steer, so prefer :func:`understeer_gradient` near it."""
+    return _steering_sensitivity(skid_pad_point(car, ay_g, radius))
+
+
+def roll_gradient(car, ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
+    """Roll gradient d roll / d ay (deg/g; positive: the chassis rolls towards the outside)
+    at ``ay_g`` (g) on ``radius`` (m)."""
+    return _roll_gradient(skid_pad_point(car, ay_g, radius))
+
+
+def camber_gradient(car, corner="front_left", ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
+    """Camber gradient (deg/g) of the wheel ``corner`` (a name of
+    :data:`jaxveh.vehicle.CORNERS`; left turn: the left wheels are the inner ones) at
+    ``ay_g`` (g) on ``radius`` (m): the derivative of the camber channel (inclination to the
+    road, ISO sign) with respect to ay, everything included (roll, suspension travel, chassis
+    deformation; Table 7.1's chassis-only part is :func:`jaxveh.analysis.kinematic_gradients`)."""
+    return _camber_gradient(skid_pad_point(car, ay_g, radius), corner)
+
+
+def rear_steer_gradient(car, corner="rear_left", ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
+    """Steer (toe) gradient of the rear wheel ``corner`` (deg/g; road-wheel angle, positive
+    left) at ``ay_g`` (g) on ``radius`` (m): roll steer, compliance steer and the chassis's
+    deformation together."""
+    return _rear_steer_gradient(skid_pad_point(car, ay_g, radius), corner)
+
+
+def _chi(lt):
+    return _nan_unless(jnp.all(lt.ok[:2]), lt.chi_low_ay)
+
+
+def load_transfer_point(car, ay_g=LOW_AY_PAIR_G, radius=SKID_PAD_RADIUS):
+    """:class:`jaxveh.analysis.LoadTransfer` at the two lateral accelerations ``ay_g`` (g) on
+    ``radius`` (m) (pure; differentiable)."""
+    return load_transfer_core(car, jnp.asarray(np.asarray(ay_g, float) * GRAVITY), jnp.asarray(radius, jnp.float64))
+
+
+def chi(car, ay_g=LOW_AY_PAIR_G, radius=SKID_PAD_RADIUS):
+    """χ at low ay (1): the front axle's incremental share of the lateral load transfer
+    between the two ``ay_g`` (g) on ``radius`` (m),
+    :attr:`jaxveh.analysis.LoadTransfer.chi_low_ay`. NaN without the steady states."""
+    return _chi(load_transfer_point(car, ay_g, radius))
+
+
+# ---- the first coupled chassis mode ----------------------------------------------------------
+
+
+def state_matrix(car, speed_kmh=DEFAULT_SPEED_KMH):
+    """``(A, ok)``: the fast car's state matrix about straight running at ``speed_kmh``
+    (km/h), as :func:`jaxveh.analysis.linearise` builds it (forward-mode Jacobian of
+    :func:`jaxveh.analysis.linear_field` at the trim), and whether the trim converged."""
+    speed = jnp.asarray(speed_kmh / 3.6, jnp.float64)
+    trim = straight_trim(car, speed, "fast")
+    field, x0 = linear_field(car, trim, speed, ("y",))
+    w0 = jnp.zeros(15)
+    return jax.jacfwd(lambda x: field(x, w0)[0])(x0), trim.ok
+
+
+def _mac(reference, vectors):
+    num = jnp.abs(jnp.conj(reference) @ vectors) ** 2
+    return num / (jnp.sum(jnp.abs(reference) ** 2) * jnp.sum(jnp.abs(vectors) ** 2, axis=0))
+
+
+def _select(a, reference):
+    lam, left, right = jax.lax.linalg.eig(a, compute_left_eigenvectors=True, compute_right_eigenvectors=True)
+    keep = lam.imag >= 2.0 * jnp.pi * MIN_MODE_HZ
+    k = jnp.argmax(jnp.where(keep, _mac(reference, right), -1.0))
+    return lam[k], left[:, k], right[:, k]
+
+
+@jax.custom_jvp
+def matched_eigenvalue(a, reference):
+    """``(real, imag)`` (1/s) of the eigenvalue of ``a`` (real, n x n) with a positive
+    imaginary part whose right eigenvector has the largest MAC with ``reference`` (complex,
+    n). Differentiable in ``a`` by first-order perturbation (simple eigenvalue; the
+    selection is held)."""
+    lam, _, _ = _select(a, reference)
+    return lam.real, lam.imag
+
+
+@matched_eigenvalue.defjvp
+def _matched_eigenvalue_jvp(primals, tangents):
+    a, reference = primals
+    da, _ = tangents
+    lam, left, right = _select(a, reference)
+    da = da.astype(right.dtype)
+    d = (jnp.conj(left) @ da @ right) / (jnp.conj(left) @ right)
+    return (lam.real, lam.imag), (d.real, d.imag)
+
+
+def first_mode_reference(car, speed_kmh=DEFAULT_SPEED_KMH) -> np.ndarray:
+    """The reference eigenvector (complex, the fast car's state) of the first coupled chassis
+    mode of ``car``: followed with :func:`jaxveh.analysis.root_locus` along the coupling
+    factor from 0 (the free-free frame's first mode, :func:`jaxveh.analysis.first_chassis_mode`)
+    to the car's own coupling, at ``speed_kmh`` (km/h). NumPy: a set-up step, once per
+    study; compiles :func:`jaxveh.analysis.linearise`."""
+    if car.n_modes == 0:
+        raise ParameterError("the first chassis mode needs a flexible chassis: the car has modes = 0")
+    coupling = float(car.params.coupling)
+    if not coupling > 0.0:
+        raise ParameterError("the first coupled chassis mode needs coupling > 0: the car's coupling is 0")
+    locus = root_locus(car, "coupling", np.asarray([0.0, coupling]), speed=speed_kmh / 3.6)
+    j = first_chassis_mode(locus, car)
+    a, _ = jax.jit(state_matrix)(car, speed_kmh)
+    lam, vec = np.linalg.eig(np.asarray(a))
+    target = locus.eigenvalues[-1, j]
+    return vec[:, int(np.argmin(np.abs(lam - target)))]
+
+
+def _mode(car, reference, speed_kmh):
+    a, ok = state_matrix(car, speed_kmh)
+    re, im = matched_eigenvalue(a, jnp.asarray(reference))
+    return _nan_unless(ok, re), _nan_unless(ok, im)
+
+
+def first_mode_frequency(car, reference, speed_kmh=DEFAULT_SPEED_KMH):
+    """Damped frequency Im(lambda) / 2 pi (Hz) of the first coupled chassis mode (the
+    eigenvalue matching ``reference``, :func:`first_mode_reference`) about straight running
+    at ``speed_kmh`` (km/h). NaN without the trim."""
+    return _mode(car, reference, speed_kmh)[1] / (2.0 * jnp.pi)
+
+
+def first_mode_damping_ratio(car, reference, speed_kmh=DEFAULT_SPEED_KMH):
+    """Damping ratio -Re(lambda) / |lambda| (1) of the first coupled chassis mode (see
+    :func:`first_mode_frequency`)."""
+    re, im = _mode(car, reference, speed_kmh)
+    return -re / jnp.hypot(re, im)
+
+
+# ---- the frame --------------------------------------------------------------------------------
+
+
+def chassis_mass(frame: fe.Frame):
+    """Mass of the chassis frame (kg), :func:`jaxveh.fe.frame_mass`."""
+    return fe.frame_mass(frame)
+
+
+def torsional_stiffness(frame: fe.Frame):
+    """Torsional stiffness of the chassis frame (N m/deg) by the FE torsion test,
+    :func:`jaxveh.fe.torsion_test` (section 6.2.2)."""
+    return fe.torsion_test(frame).stiffness_nm_per_deg
+
+
+# ---- the registry -------------------------------------------------------------------------------
+
+
+class Source(NamedTuple):
+    """A computation objectives share: ``compute(car, **settings)`` and its ``settings``
+    (name -> default); ``prepare(car, settings) -> {name: array}``, optional, computes
+    array settings once per study (NumPy) before anything is traced."""
+
+    compute: Callable
+    settings: dict
+    prepare: Callable | None = None
+
+
+def _prepare_reference(car, settings):
+    return {"reference": first_mode_reference(car, settings["speed_kmh"])}
+
+
+SOURCES = {
+    "skid_pad": Source(skid_pad_point, {"ay_g": DEFAULT_AY_G, "radius": SKID_PAD_RADIUS}),
+    "load_transfer": Source(load_transfer_point, {"ay_g": tuple(LOW_AY_PAIR_G), "radius": SKID_PAD_RADIUS}),
+    "linear": Source(lambda car, speed_kmh, reference: _mode(car, reference, speed_kmh),
+                     {"speed_kmh": DEFAULT_SPEED_KMH}, _prepare_reference),
+}
+
+
+class Objective(NamedTuple):
+    """A registered objective: ``function`` (the pure function of the car, its settings as
+    keyword arguments), ``units``, ``description``, the shared computation ``source`` (a
+    key of :data:`SOURCES`), ``extract(data, **options)`` from that computation's result,
+    and its own ``options`` (name -> default) beyond the source's settings."""
+
+    function: Callable
+    units: str
+    description: str
+    source: str
+    extract: Callable
+    options: dict = {}
+
+    @property
+    def settings(self) -> dict:
+        """Every setting (the source's and the objective's own) with its default."""
+        return {**SOURCES[self.source].settings, **self.options}
+
+
+def _frequency(mode):
+    return mode[1] / (2.0 * jnp.pi)
+
+
+def _damping(mode):
+    return -mode[0] / jnp.hypot(mode[0], mode[1])
+
+
+#: The objectives of the car by name (study files name them).
+OBJECTIVES = {
+    "understeer_gradient": Objective(understeer_gradient, "deg/g", "understeer gradient d delta / d ay at ay_g "
+                                     "on the circle of radius (negative: oversteer)", "skid_pad", _ku),
+    "steering_sensitivity": Objective(steering_sensitivity, "g/deg", "1 / understeer gradient (Fig. 7.5b; "
+                                      "infinite at neutral steer)", "skid_pad", _steering_sensitivity),
+    "roll_gradient": Objective(roll_gradient, "deg/g", "chassis roll per g at ay_g", "skid_pad", _roll_gradient),
+    "camber_gradient": Objective(camber_gradient, "deg/g", "camber change per g of one wheel (corner) at ay_g, "
+                                 "everything included", "skid_pad", _camber_gradient, {"corner": "front_left"}),
+    "rear_steer_gradient": Objective(rear_steer_gradient, "deg/g", "road-wheel angle change per g of a rear "
+                                     "wheel (corner) at ay_g", "skid_pad", _rear_steer_gradient,
+                                     {"corner": "rear_left"}),
+    "chi": Objective(chi, "1", "front share of the lateral load transfer at low ay, between the two ay_g",
+                     "load_transfer", _chi),
+    "first_mode_frequency": Objective(first_mode_frequency, "Hz", "damped frequency of the first coupled chassis "
+                                      "mode about straight running at speed_kmh", "linear", _frequency),
+    "first_mode_damping_ratio": Objective(first_mode_damping_ratio, "1", "damping ratio of the first coupled "
+                                          "chassis mode about straight running at speed_kmh", "linear", _damping),
+}
+
+#: Objectives of the chassis frame (functions of a :class:`jaxveh.fe.Frame`): name ->
+#: (function, units, description). Not available in car studies (their design variables
+#: are ``CarParams`` paths, which do not reach the frame's sections).
+FRAME_OBJECTIVES = {
+    "chassis_mass": (chassis_mass, "kg", "mass of the chassis frame (FE)"),
+    "torsional_stiffness": (torsional_stiffness, "N m/deg", "torsional stiffness of the chassis frame (FE torsion "
+                                                            "test)"),
+}
+
+
+class ObjectiveSpec(NamedTuple):
+    """One objective of a study: its ``name`` in :data:`OBJECTIVES` and its ``settings``
+    (sorted ``(key, value)`` pairs; hashable, so a spec can be a static argument)."""
+
+    name: str
+    settings: tuple
+
+    @property
+    def source_key(self) -> tuple:
+        """``(source, settings of the source)``: objectives with one key share a computation."""
+        objective = OBJECTIVES[self.name]
+        own = SOURCES[objective.source].settings
+        return objective.source, tuple((k, v) for k, v in self.settings if k in own)
+
+    @property
+    def options(self) -> dict:
+        """The objective's own settings (beyond its source's)."""
+        objective = OBJECTIVES[self.name]
+        return {k: v for k, v in self.settings if k in objective.options}
+
+
+def objective_spec(name: str, settings: dict | None = None) -> ObjectiveSpec:
+    """An :class:`ObjectiveSpec` of ``name`` with ``settings`` over the defaults (settings
+    that are arrays, a :class:`Source`'s prepared ones, are not part of the spec).
+    ``ParameterError`` for an unknown objective or setting."""
+    if name not in OBJECTIVES:
+        extra = " (an objective of the frame, not of the car)" if name in FRAME_OBJECTIVES else ""
+        raise ParameterError(f"objective {name!r} is not known{extra}: allowed {', '.join(OBJECTIVES)}")
+    defaults = OBJECTIVES[name].settings
+    settings = dict(settings or {})
+    unknown = sorted(set(settings) - set(defaults))
+    if unknown:
+        raise ParameterError(f"objective {name!r} has no setting {unknown[0]!r}: allowed "
+                             f"{', '.join(defaults) or 'none'}")
+    merged = {**defaults, **settings}
+    return ObjectiveSpec(name, tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in merged.items())))
+
+
+def prepare(car, specs) -> dict:
+    """The prepared (array) settings of every source of ``specs`` that needs them:
+    ``{source_key: {name: array}}`` (NumPy, before tracing)."""
+    out = {}
+    for spec in specs:
+        key = spec.source_key
+        source = SOURCES[key[0]]
+        if source.prepare is not None and key not in out:
+            out[key] = source.prepare(car, dict(key[1]))
+    return out
+
+
+def objective_values(car, specs, prepared=None):
+    """The values of the objectives ``specs`` (a tuple of :class:`ObjectiveSpec`) of ``car``
+    as one array (their units of :data:`OBJECTIVES`), each shared computation done once;
+    ``prepared``: :func:`prepare`'s arrays. Pure and differentiable; NaN where a steady
+    state or trim failed."""
+    prepared = {} if prepared is None else prepared
+    data = {}
+    for spec in specs:
+        key = spec.source_key
+        if key not in data:
+            data[key] = SOURCES[key[0]].compute(car, **dict(key[1]), **prepared.get(key, {}))
+    return jnp.stack([jnp.asarray(OBJECTIVES[s.name].extract(data[s.source_key], **s.options), jnp.float64)
+                      for s in specs])

@@ -1,0 +1,842 @@
+"""Optimisation study files: bounded design variables of the car, an objective from the
+library (:data:`optimise.OBJECTIVES`) driven to a target or minimised/maximised, optional
+constraints, and the optimiser, as TOML (``jaxveh optimise STUDY.toml``). Loading checks
+everything it can before the car is built and raises :class:`~jaxveh.ParameterError` naming
+the file, the key and what is allowed; the car, the model settings, the variable paths and
+the ``lambda`` label are the sweep studies' (:mod:`optimise._study`).
+
+A study file::
+
+    [study]
+    name = "roll_balance"             # output names; default: the file's stem
+    description = "..."               # optional
+    model = "car"                     # the chapter-6 car (the only model optimised so far)
+    vehicle = "my_car.toml"           # optional car file, relative to the study file
+    modes = 6                         # chassis modes (0: rigid)
+
+    [[variables]]                     # one table per design variable
+    path = "lambda"                   # a path into CarParams or the label lambda
+    lower = 0.3                       # bounds (the optimiser stays strictly inside)
+    upper = 0.7
+    initial = 0.5                     # optional; default the middle (geometric with log)
+    log = false                       # optional: optimise log(value)
+    name = "lam"                      # optional coordinate name; units optional
+
+    [objective]                       # one objective ...
+    name = "understeer_gradient"      # a name of OBJECTIVES
+    target = 0.1                      # ((f - target) / scale)^2 ... or minimise = true / maximise = true
+    scale = 0.1                       # in the objective's units (default 1)
+    ay_g = 0.05                       # the objective's settings (OBJECTIVES[name].settings)
+    radius = 50.0
+
+    # [[objectives]]                  # ... or a weighted sum: the same keys plus weight = w
+
+    [[constraints]]                   # optional: f <= bound and/or f >= bound
+    name = "roll_gradient"
+    "<=" = 1.2
+    scale = 0.1                       # the violation's scale (default 1)
+
+    [optimiser]
+    method = "lbfgs"                  # "lbfgs" (Optax's L-BFGS direction, Armijo backtracking) or "adam"
+    steps = 30                        # iterations per outer (augmented-Lagrangian) iteration
+    learning_rate = 0.05              # adam only
+    tolerance = 1e-8                  # converged when the gradient norm (unconstrained variables) is below
+    outer_steps = 8                   # with constraints: multiplier updates
+
+    [run]
+    out = "results/roll_balance"      # default results/<name>
+
+The optimiser works on unconstrained variables ``z`` (``optimise.Problem``'s logistic map
+into the bounds); every iteration evaluates the objectives and constraints and their exact
+Jacobian with respect to ``z`` in one compiled forward-mode program (``jax.jacfwd``: a few
+design variables, a steady state with the implicit function theorem inside). Constraints
+``g <= 0`` (normalised by their scale) enter by the Powell-Hestenes-Rockafellar augmented
+Lagrangian as in :func:`optimise.solve`.
+"""
+
+import csv
+import dataclasses
+import json
+import math
+import re
+import time
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+from typing import NamedTuple, Optional
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+import tomllib
+
+from jaxveh import ParameterError, vehicle
+from jaxveh._core import run_time_checks_off
+from jaxveh.params import UNIT_TO_SI, get_at, read_car_file, set_all
+from jaxveh.vehicle import CORNERS
+
+from ._objectives import (
+    FRAME_OBJECTIVES,
+    OBJECTIVES,
+    ObjectiveSpec,
+    arb_rates_for_lambda,
+    objective_spec,
+    objective_values,
+    prepare,
+    roll_rate_coefficients,
+)
+from ._problem import Problem, Variable
+from ._study import LABELS, Study, SweepVariable, _check_keys, _err, _is_number, _positive_int, _variable, check_study
+from ._sweep import _check_path
+
+#: Optimisation methods.
+METHODS = ("lbfgs", "adam")
+#: How an objective term is driven.
+SENSES = ("target", "minimise", "maximise")
+#: Default optimiser settings.
+DEFAULT_OPTIMISER = {"method": "lbfgs", "steps": 30, "learning_rate": 0.05, "tolerance": 1e-8, "memory": 10,
+                     "outer_steps": 8, "rho": 10.0, "rho_growth": 4.0, "constraint_tol": 1e-6}
+#: Armijo sufficient-decrease constant and the most halvings of the L-BFGS line search.
+ARMIJO_C1, MAX_HALVINGS = 1e-4, 30
+#: The parts of CarParams the λ label's rate coefficients depend on: a study may not vary
+#: them together with λ (:func:`optimise.arb_rates_for_lambda`).
+LAMBDA_EXCLUDES = ("vehicle", "springs", "arb_rates")
+#: CarParams paths written back into a car file: path -> (section, key, unit of the file).
+CAR_FILE_KEYS = {
+    "arb_rates[0]": ("suspension_front", "arb_rate", "Nm/rad"),
+    "arb_rates[1]": ("suspension_rear", "arb_rate", "Nm/rad"),
+    "coupling": ("chassis", "coupling", "-"),
+    "rack_ratio": ("steering", "rack_ratio", "mm/deg"),
+}
+
+_KEYS = {
+    "file": ("study", "variables", "objective", "objectives", "constraints", "optimiser", "run"),
+    "study": ("name", "description", "model", "vehicle", "modes"),
+    "variables": ("path", "name", "units", "lower", "upper", "initial", "log"),
+    "term": ("name", "target", "minimise", "maximise", "scale", "weight"),
+    "constraint": ("name", "<=", ">=", "scale"),
+    "optimiser": tuple(DEFAULT_OPTIMISER),
+    "run": ("out",),
+}
+
+
+class DesignVariable(NamedTuple):
+    """A design variable: coordinate ``name``, ``path`` (into CarParams, or ``"lambda"``),
+    bounds, ``initial`` value, ``log`` scale and ``units``."""
+
+    name: str
+    path: str
+    lower: float
+    upper: float
+    initial: float
+    log: bool = False
+    units: str = "SI"
+
+
+class Term(NamedTuple):
+    """One objective term: ``spec`` (objective and settings), ``sense`` (:data:`SENSES`),
+    ``target`` (for "target"), ``scale`` and ``weight``."""
+
+    spec: ObjectiveSpec
+    sense: str
+    target: Optional[float]
+    scale: float = 1.0
+    weight: float = 1.0
+
+    def value(self, f):
+        """The term's contribution at objective value ``f`` (NumPy or JAX)."""
+        if self.sense == "target":
+            return self.weight * ((f - self.target) / self.scale) ** 2
+        return self.weight * (f if self.sense == "minimise" else -f) / self.scale
+
+    def slope(self, f):
+        """d value / d f."""
+        if self.sense == "target":
+            return self.weight * 2.0 * (f - self.target) / self.scale**2
+        return self.weight * (1.0 if self.sense == "minimise" else -1.0) / self.scale
+
+
+class Bound(NamedTuple):
+    """A constraint ``spec <= upper`` (``kind`` "<=") or ``spec >= lower`` (">="), its
+    violation ``(f - bound) / scale`` (or ``(bound - f) / scale``) feasible when <= 0."""
+
+    spec: ObjectiveSpec
+    kind: str
+    bound: float
+    scale: float = 1.0
+
+    def violation(self, f):
+        return ((f - self.bound) if self.kind == "<=" else (self.bound - f)) / self.scale
+
+    @property
+    def sign(self) -> float:
+        return 1.0 if self.kind == "<=" else -1.0
+
+
+class OptimisationStudy(NamedTuple):
+    """A loaded optimisation study file (module docs); ``file`` for messages."""
+
+    name: str
+    variables: tuple[DesignVariable, ...]
+    terms: tuple[Term, ...]
+    constraints: tuple[Bound, ...] = ()
+    optimiser: dict = DEFAULT_OPTIMISER
+    vehicle: Optional[str] = None
+    modes: int = 6
+    model: str = "car"
+    out: str = "results/study"
+    description: str = ""
+    file: Optional[str] = None
+
+    @property
+    def specs(self) -> tuple[ObjectiveSpec, ...]:
+        """Every objective evaluated: the terms' then the constraints', each once."""
+        return tuple(dict.fromkeys([t.spec for t in self.terms] + [c.spec for c in self.constraints]))
+
+    def where(self, key: str) -> str:
+        return f"{self.file if self.file else 'study'}: {key}"
+
+
+# ---- loading ----------------------------------------------------------------------------------
+
+
+def _number(where, key, value, low=None, *, positive=False) -> float:
+    if not _is_number(value):
+        raise _err(where, key, f"= {value!r} is not allowed: a finite number")
+    if positive and not value > 0:
+        raise _err(where, key, f"= {value!r} is not allowed: a number > 0")
+    return float(value)
+
+
+def _design_variable(where: str, i: int, table, model: str) -> DesignVariable:
+    key = f"variables[{i}]"
+    if not isinstance(table, dict):
+        raise _err(where, key, "is not a table: write [[variables]] tables")
+    _check_keys(where, "variables", table, _KEYS["variables"])
+    for k in ("lower", "upper"):
+        if k not in table:
+            raise _err(where, f"{key}.{k}", "is missing: a design variable needs lower and upper bounds")
+        _number(where, f"{key}.{k}", table[k])
+    lower, upper = float(table["lower"]), float(table["upper"])
+    if not lower < upper:
+        raise _err(where, key, f"has lower = {lower!r}, upper = {upper!r}: reversed or empty bounds, allowed "
+                   "lower < upper")
+    log = table.get("log", False)
+    if not isinstance(log, bool):
+        raise _err(where, f"{key}.log", f"= {log!r} is not allowed: true or false")
+    if log and not lower > 0:
+        raise _err(where, f"{key}.lower", f"= {lower!r} is not allowed with log = true: lower > 0")
+    initial = table.get("initial", math.sqrt(lower * upper) if log else 0.5 * (lower + upper))
+    initial = _number(where, f"{key}.initial", initial)
+    if not lower < initial < upper:
+        raise _err(where, f"{key}.initial", f"= {initial!r} is not allowed: strictly between lower = {lower!r} "
+                   f"and upper = {upper!r}")
+    # the sweep's checks of the path (or label), the name, the units and the label's range
+    sweep_table = {k: table[k] for k in ("path", "name", "units") if k in table} | {"values": [lower, upper]}
+    var = _variable(where, i, sweep_table, model)
+    return DesignVariable(name=var.name, path=var.path, lower=lower, upper=upper, initial=initial, log=log,
+                          units=var.units)
+
+
+def _settings(table: dict, reserved) -> dict:
+    return {k: v for k, v in table.items() if k not in reserved}
+
+
+def _spec(where: str, key: str, table: dict, reserved) -> ObjectiveSpec:
+    name = table.get("name")
+    if not isinstance(name, str):
+        raise _err(where, f"{key}.name", f"= {name!r} is not allowed: one of {', '.join(OBJECTIVES)}")
+    if name in FRAME_OBJECTIVES:
+        raise _err(where, f"{key}.name", f"= {name!r} is an objective of the chassis frame (a function of "
+                   "jaxveh.fe.Frame), not of the car's parameters: allowed in a car study "
+                   f"{', '.join(OBJECTIVES)}")
+    if name not in OBJECTIVES:
+        raise _err(where, f"{key}.name", f"= {name!r} is not a known objective: allowed {', '.join(OBJECTIVES)}")
+    settings = _settings(table, reserved)
+    allowed = OBJECTIVES[name].settings
+    for k, v in settings.items():
+        if k not in allowed:
+            raise _err(where, f"{key}.{k}", f"is not a key of objective {name!r}: allowed "
+                       f"{', '.join(reserved + tuple(allowed))}")
+        default = allowed[k]
+        if isinstance(default, str):
+            ok = isinstance(v, str)
+        elif isinstance(default, tuple):
+            ok = isinstance(v, list) and len(v) == len(default) and all(_is_number(x) and x > 0 for x in v) \
+                and all(b > a for a, b in zip(v, v[1:]))
+        else:
+            ok = _is_number(v) and v > 0
+        if not ok:
+            what = ("a string" if isinstance(default, str) else
+                    f"{len(default)} increasing numbers > 0" if isinstance(default, tuple) else "a number > 0")
+            raise _err(where, f"{key}.{k}", f"= {v!r} is not allowed: {what} (default {default!r})")
+    if "corner" in settings:
+        corners = [c for c in CORNERS if name != "rear_steer_gradient" or c.startswith("rear")]
+        if settings["corner"] not in corners:
+            raise _err(where, f"{key}.corner", f"= {settings['corner']!r} is not allowed: one of {', '.join(corners)}")
+    spec = objective_spec(name, {k: float(v) if _is_number(v) else v for k, v in settings.items()})
+    return spec
+
+
+def _term(where: str, key: str, table, weighted: bool) -> Term:
+    if not isinstance(table, dict):
+        raise _err(where, key, "is not a table")
+    reserved = _KEYS["term"]
+    spec = _spec(where, key, table, reserved)
+    senses = [s for s in ("target", "minimise", "maximise") if s in table]
+    if len(senses) != 1:
+        raise _err(where, key, f"needs exactly one of target = VALUE, minimise = true, maximise = true; got "
+                   f"{', '.join(senses) or 'none'}")
+    sense = senses[0]
+    target = None
+    if sense == "target":
+        target = _number(where, f"{key}.target", table["target"])
+    elif table[sense] is not True:
+        raise _err(where, f"{key}.{sense}", f"= {table[sense]!r} is not allowed: true")
+    scale = _number(where, f"{key}.scale", table.get("scale", 1.0), positive=True)
+    if "weight" in table and not weighted:
+        raise _err(where, f"{key}.weight", "applies to [[objectives]] (a weighted sum) only")
+    weight = _number(where, f"{key}.weight", table.get("weight", 1.0), positive=True)
+    return Term(spec=spec, sense=sense, target=target, scale=scale, weight=weight)
+
+
+def _constraints(where: str, tables) -> tuple[Bound, ...]:
+    if not isinstance(tables, list):
+        raise _err(where, "constraints", "is not an array of tables: write [[constraints]] tables")
+    out, bounds = [], {}
+    for i, table in enumerate(tables):
+        key = f"constraints[{i}]"
+        if not isinstance(table, dict):
+            raise _err(where, key, "is not a table: write [[constraints]] tables")
+        spec = _spec(where, key, table, _KEYS["constraint"])
+        kinds = [k for k in ("<=", ">=") if k in table]
+        if not kinds:
+            raise _err(where, key, 'needs a bound: "<=" = VALUE and/or ">=" = VALUE')
+        scale = _number(where, f"{key}.scale", table.get("scale", 1.0), positive=True)
+        for kind in kinds:
+            bound = _number(where, f'{key}."{kind}"', table[kind])
+            out.append(Bound(spec=spec, kind=kind, bound=bound, scale=scale))
+            bounds.setdefault(spec, []).append((kind, bound, key))
+    for spec, items in bounds.items():  # the bounds on one quantity must leave an interval
+        lows = [(b, k) for kind, b, k in items if kind == ">="]
+        highs = [(b, k) for kind, b, k in items if kind == "<="]
+        if lows and highs:
+            (low, k_low), (high, k_high) = max(lows), min(highs)
+            if low > high:
+                raise _err(where, k_low, f'is infeasible: {spec.name} >= {low!r} ({k_low}) and <= {high!r} '
+                           f'({k_high}) leave no value; allowed ">=" bound <= "<=" bound')
+    return tuple(out)
+
+
+def _optimiser(where: str, table) -> dict:
+    if not isinstance(table, dict):
+        raise _err(where, "optimiser", "is not a table: write an [optimiser] section")
+    _check_keys(where, "optimiser", table, _KEYS["optimiser"])
+    out = {**DEFAULT_OPTIMISER, **table}
+    if out["method"] not in METHODS:
+        raise _err(where, "optimiser.method", f"= {out['method']!r} is not allowed: one of {', '.join(METHODS)}")
+    for k, high in (("steps", 100_000), ("memory", 100), ("outer_steps", 1000)):
+        out[k] = _positive_int(where, f"optimiser.{k}", out[k], 1, high)
+    for k in ("learning_rate", "tolerance", "rho", "constraint_tol"):
+        out[k] = _number(where, f"optimiser.{k}", out[k], positive=True)
+    out["rho_growth"] = _number(where, "optimiser.rho_growth", out["rho_growth"])
+    if out["rho_growth"] < 1.0:
+        raise _err(where, "optimiser.rho_growth", f"= {out['rho_growth']!r} is not allowed: a number >= 1")
+    return out
+
+
+def _check_lambda(where: str, variables) -> None:
+    if "lambda" not in [v.path for v in variables]:
+        return
+    for i, v in enumerate(variables):
+        root = re.split(r"[.\[]", v.path)[0]
+        if root in LAMBDA_EXCLUDES:
+            raise _err(where, f"variables[{i}].path", f"= {v.path!r} cannot be varied together with lambda (set "
+                       "through the anti-roll bars with the base car's roll-rate coefficients): allowed with "
+                       f"lambda are paths outside {', '.join(LAMBDA_EXCLUDES)}")
+
+
+def load_optimisation_study(path, *, out=None) -> OptimisationStudy:
+    """The optimisation study of the TOML file ``path`` (module docs), with the output
+    folder ``out`` overridden. ``ParameterError`` naming the file and key for anything not
+    allowed; the paths into CarParams and the bounds' ranges are checked on the car when it
+    is built (:func:`build_design`)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"study file {str(path)!r} not found")
+    where = str(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise ParameterError(f"{where}: not valid TOML: {e}") from None
+    _check_keys(where, "file", data, _KEYS["file"])
+    for section in ("study", "optimiser", "run"):
+        if not isinstance(data.get(section, {}), dict):
+            raise _err(where, section, f"is not a table: write a [{section}] section")
+    study_t, run_t = data.get("study", {}), data.get("run", {})
+    _check_keys(where, "study", study_t, _KEYS["study"])
+    _check_keys(where, "run", run_t, _KEYS["run"])
+    model = study_t.get("model", "car")
+    if model != "car":
+        raise _err(where, "study.model", f"= {model!r} is not allowed: 'car' (the chapter-6 car; the chapter-3 "
+                   "model's optimisation is optimise.solve)")
+    tables = data.get("variables", [])
+    if not isinstance(tables, list) or not tables:
+        raise _err(where, "variables", "is missing or empty: a study needs at least one [[variables]] table")
+    variables = tuple(_design_variable(where, i, t, model) for i, t in enumerate(tables))
+    _check_lambda(where, variables)
+    if ("objective" in data) == ("objectives" in data):
+        raise _err(where, "objective", "is needed: one [objective] table or an array of [[objectives]] tables "
+                   "(a weighted sum), not both")
+    if "objective" in data:
+        terms = (_term(where, "objective", data["objective"], weighted=False),)
+    else:
+        if not isinstance(data["objectives"], list) or not data["objectives"]:
+            raise _err(where, "objectives", "is not a non-empty array of tables: write [[objectives]] tables")
+        terms = tuple(_term(where, f"objectives[{i}]", t, weighted=True) for i, t in enumerate(data["objectives"]))
+    constraints = _constraints(where, data.get("constraints", []))
+    optimiser = _optimiser(where, data.get("optimiser", {}))
+    name = study_t.get("name", path.stem)
+    if not isinstance(name, str) or not re.match(r"^[A-Za-z0-9_.-]+$", name):
+        raise _err(where, "study.name", f"= {name!r} is not allowed: letters, digits, '_', '.', '-'")
+    description = study_t.get("description", "")
+    if not isinstance(description, str):
+        raise _err(where, "study.description", "is not a string")
+    out = str(out) if out is not None else run_t.get("out", f"results/{name}")
+    if not isinstance(out, str) or not out:
+        raise _err(where, "run.out", f"= {out!r} is not allowed: a folder path")
+    # the sweep loader's checks of the car settings (model, vehicle file, modes, repeated names)
+    sweep = check_study(_sweep_study(where, path, study_t, variables))
+    return OptimisationStudy(name=name, variables=variables, terms=terms, constraints=constraints,
+                             optimiser=optimiser, vehicle=sweep.vehicle, modes=sweep.modes, model=model, out=out,
+                             description=description, file=where)
+
+
+def _sweep_study(where, path: Path, study_t: dict, variables) -> Study:
+    """The sweep :class:`~optimise.Study` with the same car and variables (values: the
+    bounds and the initial value), for the sweep loader's and model builder's checks."""
+    vehicle_file = study_t.get("vehicle")
+    if vehicle_file is not None:
+        if not isinstance(vehicle_file, str):
+            raise _err(where, "study.vehicle", f"= {vehicle_file!r} is not allowed: a file path")
+        resolved = Path(vehicle_file) if Path(vehicle_file).is_absolute() else path.parent / vehicle_file
+        if not resolved.is_file():
+            raise _err(where, "study.vehicle", f"= {vehicle_file!r}: file {str(resolved)!r} not found")
+        vehicle_file = str(resolved.resolve())
+    sweep_vars = tuple(SweepVariable(name=v.name, path=v.path, values=tuple(sorted({v.lower, v.initial, v.upper})),
+                                     units=v.units, log=v.log) for v in variables)
+    return Study(name="s", model="car", variables=sweep_vars, quantities=("chi",), vehicle=vehicle_file,
+                 modes=study_t.get("modes", 6), file=where)
+
+
+# ---- the design -------------------------------------------------------------------------------
+
+
+class Design(NamedTuple):
+    """A study's car and compiled evaluation: the base ``car``, the ``problem`` (bounded
+    variables on ``(car, coefficients)``), the objective ``specs`` and their ``prepared``
+    arrays, and ``evaluate(z) -> (values, jacobian)`` (NumPy; one compiled program)."""
+
+    car: object
+    problem: Problem
+    specs: tuple
+    prepared: dict
+    evaluate: Callable
+
+
+@dataclasses.dataclass(frozen=True)
+class _DesignApply:
+    """``apply(base, values)`` of the study's :class:`~optimise.Problem` on ``base = (car,
+    coefficients)``: the path variables set on CarParams, then λ through the anti-roll bars.
+    Hashable by value, so that one study's program compiles once per process."""
+
+    paths: tuple  # (name, path) of the path variables
+    lam: Optional[str]  # the name of the lambda variable, if any
+
+    def __call__(self, base, values):
+        car, coefficients = base
+        params = set_all(car.params, {p: values[n] for n, p in self.paths})
+        if self.lam is not None:
+            rates = arb_rates_for_lambda(coefficients, values[self.lam])
+            params = eqx.tree_at(lambda p: p.arb_rates, params, rates)
+        return eqx.tree_at(lambda c: c.params, car, params), coefficients
+
+
+@dataclasses.dataclass(frozen=True)
+class _StudyObjective:
+    """The study's weighted objective of ``base = (car, coefficients)`` (its terms' sum; no
+    constraints), hashable by value."""
+
+    terms: tuple
+    specs: tuple
+
+    def __call__(self, base, prepared=None):
+        values = objective_values(base[0], self.specs, prepared)
+        return sum(t.value(values[self.specs.index(t.spec)]) for t in self.terms)
+
+
+def design_car(design: Design, values: dict):
+    """The car at the design variables' ``values`` ({name: value})."""
+    return design.problem.apply(design.problem.params, {k: jnp.asarray(v, jnp.float64) for k, v in values.items()})[0]
+
+
+def _values_and_jacobian(z, problem, specs, prepared):
+    def values(z):
+        car, _ = problem.build(z)
+        v = objective_values(car, specs, prepared)
+        return v, v
+
+    jac, v = jax.jacfwd(values, has_aux=True)(z)
+    return v, jac
+
+
+_compiled = eqx.filter_jit(_values_and_jacobian)
+
+
+def build_design(study: OptimisationStudy) -> Design:
+    """The car of ``study`` with its variables checked on it (the path exists, names one
+    number, and the bounds and initial value are in the car's ranges; ``ParameterError``
+    naming the key), the prepared objective settings, and the compiled evaluation."""
+    car = vehicle.load_car(study.vehicle, modes=study.modes)
+    sweep = _sweep_study(study.file or "study", Path(study.file or "."), {"modes": study.modes}, study.variables)
+    sweep = sweep._replace(vehicle=study.vehicle)
+    check = lambda params: vehicle.check_car(eqx.tree_at(lambda c: c.params, car, params))  # noqa: E731
+    for i, v in enumerate(study.variables):
+        if v.path not in LABELS["car"]:
+            _check_path(sweep, i, car.params, check)
+    coefficients = roll_rate_coefficients(car)
+    specs = study.specs
+    try:
+        prepared = prepare(car, specs)
+    except ParameterError as e:
+        raise ParameterError(f"{study.where('objective')}: {e}") from None
+    apply = _DesignApply(paths=tuple((v.name, v.path) for v in study.variables if v.path not in LABELS["car"]),
+                         lam=next((v.name for v in study.variables if v.path == "lambda"), None))
+    problem = Problem(params=(car, coefficients),
+                      variables=tuple(Variable(v.name, v.lower, v.upper, v.log) for v in study.variables),
+                      objective=_StudyObjective(study.terms, specs), apply=apply)
+    # the mode objectives' forward-mode linearisation is kept out of JAX's disk cache (its
+    # run-time checks stay traced: loading that program back segfaults, docs/analysis.md);
+    # everything else is traced without them, so the disk cache keeps the program
+    cacheable = all(s.source_key[0] != "linear" for s in specs)
+
+    def evaluate(z):
+        if cacheable:
+            with run_time_checks_off():
+                v, jac = _compiled(jnp.asarray(z), problem, specs, prepared)
+        else:
+            v, jac = _compiled(jnp.asarray(z), problem, specs, prepared)
+        return np.asarray(v), np.asarray(jac)
+
+    return Design(car=car, problem=problem, specs=specs, prepared=prepared, evaluate=evaluate)
+
+
+# ---- the optimisation -------------------------------------------------------------------------
+
+
+class OptimisationResult(NamedTuple):
+    """An optimisation's outcome: ``optimum`` ({variable: value}), the weighted
+    ``objective`` there, each objective's value ``values`` ({name: value}), the constraints
+    (``constraints``: one dict per bound with value and violation), ``converged`` (the
+    gradient norm fell below the tolerance with every constraint within its tolerance),
+    ``message``, ``iterations``, ``evaluations`` (compiled calls), ``history`` (one dict per
+    iteration: iteration, objective, merit, grad_norm, the variables, the objectives'
+    values), ``car`` (at the optimum), ``failed`` (a failed steady state or trim ended the
+    run) and ``wall_s``."""
+
+    study: OptimisationStudy
+    optimum: dict
+    objective: float
+    values: dict
+    constraints: list
+    converged: bool
+    message: str
+    iterations: int
+    evaluations: int
+    history: list
+    car: object
+    failed: bool
+    wall_s: float
+
+
+class OptimisationError(RuntimeError):
+    """A failed simulation (steady state, trim) during an optimisation; ``result`` holds
+    the run so far (its history, the last good design)."""
+
+    def __init__(self, message: str, result: OptimisationResult):
+        super().__init__(message)
+        self.result = result
+
+
+def _label(spec: ObjectiveSpec, specs) -> str:
+    """A unique column name for an objective (its name, with its settings if it repeats)."""
+    if sum(s.name == spec.name for s in specs) == 1:
+        return spec.name
+    return spec.name + "[" + ",".join(f"{k}={v}" for k, v in spec.settings) + "]"
+
+
+class _Evaluation(NamedTuple):
+    z: np.ndarray
+    values: np.ndarray
+    jac: np.ndarray
+
+
+def _merit(study, index, ev: _Evaluation, multipliers, rho):
+    """(weighted objective, augmented merit, its gradient in z, constraint violations)."""
+    f, grad = 0.0, np.zeros_like(ev.z)
+    for t in study.terms:
+        k = index[t.spec]
+        f += float(t.value(ev.values[k]))
+        grad = grad + float(t.slope(ev.values[k])) * ev.jac[k]
+    merit = f
+    violations = np.zeros(len(study.constraints))
+    for j, c in enumerate(study.constraints):
+        k = index[c.spec]
+        g = float(c.violation(ev.values[k]))
+        violations[j] = g
+        active = max(0.0, multipliers[j] + rho * g)
+        merit += (active**2 - multipliers[j] ** 2) / (2.0 * rho)
+        grad = grad + active * c.sign / c.scale * ev.jac[k]
+    return f, merit, grad, violations
+
+
+def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None, throw: bool = True,
+                   design: Optional[Design] = None) -> OptimisationResult:
+    """Run ``study`` (module docs): L-BFGS (Optax's direction, Armijo backtracking on the
+    host) or Adam on the unconstrained variables, inside augmented-Lagrangian outer
+    iterations when there are constraints. ``progress(entry)`` is called with every history
+    entry. A non-finite objective, constraint or gradient (a steady state or trim that
+    failed) ends the run: :class:`OptimisationError` with the result so far when ``throw``,
+    else that result with ``failed`` True."""
+    start = time.perf_counter()
+    design = build_design(study) if design is None else design
+    problem, specs = design.problem, design.specs
+    index = {s: k for k, s in enumerate(specs)}
+    labels = [_label(s, specs) for s in specs]
+    opts = study.optimiser
+    multipliers = np.zeros(len(study.constraints))
+    rho = float(opts["rho"])
+    history: list = []
+    counts = {"evaluations": 0}
+
+    def evaluate(z) -> _Evaluation:
+        counts["evaluations"] += 1
+        v, jac = design.evaluate(z)
+        return _Evaluation(np.asarray(z, float), v, jac)
+
+    def finite(ev: _Evaluation) -> bool:
+        return bool(np.all(np.isfinite(ev.values)) and np.all(np.isfinite(ev.jac)))
+
+    def record(ev, outer, f, merit, grad, violations):
+        values = {k: float(x) for k, x in problem.to_values(jnp.asarray(ev.z)).items()}
+        entry = {"iteration": len(history), "outer": outer, "evaluations": counts["evaluations"], "objective": f,
+                 "merit": merit, "grad_norm": float(np.linalg.norm(grad)), **values,
+                 **{label: float(x) for label, x in zip(labels, ev.values)},
+                 **{f"violation_{j}": float(g) for j, g in enumerate(violations)}}
+        history.append(entry)
+        if progress is not None:
+            progress(entry)
+
+    def result(ev, converged, message, failed=False):
+        optimum = {k: float(x) for k, x in problem.to_values(jnp.asarray(ev.z)).items()}
+        f, _, _, violations = _merit(study, index, ev, multipliers, rho) if finite(ev) else (math.nan,) * 3 + (
+            np.full(len(study.constraints), math.nan),)
+        cons = [{"name": c.spec.name, "kind": c.kind, "bound": c.bound, "value": float(ev.values[index[c.spec]]),
+                 "violation": float(g)} for c, g in zip(study.constraints, violations)]
+        return OptimisationResult(study=study, optimum=optimum, objective=float(f),
+                                  values={label: float(x) for label, x in zip(labels, ev.values)}, constraints=cons,
+                                  converged=converged, message=message, iterations=len(history),
+                                  evaluations=counts["evaluations"], history=history,
+                                  car=design_car(design, optimum), failed=failed,
+                                  wall_s=time.perf_counter() - start)
+
+    def failure(ev, good, where):
+        bad = [label for label, x in zip(labels, ev.values) if not np.isfinite(x)] or ["a gradient"]
+        at = ", ".join(f"{k} = {float(x):.6g}" for k, x in problem.to_values(jnp.asarray(ev.z)).items())
+        message = (f"failed simulation {where}: {', '.join(bad)} not finite at {at} (no steady state or trim there; "
+                   "narrow the bounds)")
+        res = result(good if good is not None else ev, False, message, failed=True)
+        if throw:
+            raise OptimisationError(message, res)
+        return res
+
+    ev = evaluate(problem.to_z({v.name: v.initial for v in study.variables}))
+    if not finite(ev):
+        return failure(ev, None, "at the initial design")
+    converged, message = False, "the iteration limit was reached"
+    for outer in range(opts["outer_steps"] if study.constraints else 1):
+        f, merit, grad, violations = _merit(study, index, ev, multipliers, rho)
+        record(ev, outer, f, merit, grad, violations)
+        if opts["method"] == "adam":
+            opt = optax.adam(opts["learning_rate"])
+        else:
+            opt = optax.scale_by_lbfgs(memory_size=opts["memory"])
+        with jax.numpy_dtype_promotion("standard"):
+            state = opt.init(jnp.asarray(ev.z))
+        inner_converged = False
+        for _ in range(opts["steps"]):
+            if np.linalg.norm(grad) <= opts["tolerance"]:
+                inner_converged = True
+                break
+            with jax.numpy_dtype_promotion("standard"):
+                updates, state = opt.update(jnp.asarray(grad), state, jnp.asarray(ev.z))
+            step = np.asarray(updates)
+            if opts["method"] == "adam":
+                trial = evaluate(ev.z + step)
+                if not finite(trial):
+                    return failure(trial, ev, f"at iteration {len(history)}")
+                ev = trial
+            else:
+                direction = -step
+                slope = float(grad @ direction)
+                if not slope < 0.0:  # not a descent direction: restart from steepest descent
+                    direction, slope = -grad, -float(grad @ grad)
+                t, accepted = 1.0, None
+                for _ in range(MAX_HALVINGS):
+                    trial = evaluate(ev.z + t * direction)
+                    if finite(trial):
+                        trial_merit = _merit(study, index, trial, multipliers, rho)[1]
+                        if trial_merit <= merit + ARMIJO_C1 * t * slope:
+                            accepted = trial
+                            break
+                    t *= 0.5
+                if accepted is None:
+                    if not finite(trial):
+                        return failure(trial, ev, f"in the line search of iteration {len(history)}")
+                    message = "the line search found no decrease (round-off level reached)"
+                    inner_converged = np.linalg.norm(grad) <= 1e3 * opts["tolerance"]
+                    break
+                ev = accepted
+            f, merit, grad, violations = _merit(study, index, ev, multipliers, rho)
+            record(ev, outer, f, merit, grad, violations)
+        worst = float(np.max(violations, initial=0.0))
+        if not study.constraints:
+            converged = inner_converged or np.linalg.norm(grad) <= opts["tolerance"]
+            break
+        multipliers = np.maximum(0.0, multipliers + rho * violations)
+        if worst > opts["constraint_tol"]:
+            rho *= opts["rho_growth"]
+        elif inner_converged:
+            converged = True
+            break
+    if converged:
+        message = "converged: gradient norm below the tolerance" + (" with the constraints met"
+                                                                     if study.constraints else "")
+    return result(ev, bool(converged), message)
+
+
+# ---- outputs ---------------------------------------------------------------------------------
+
+
+def result_report(result: OptimisationResult, files: Optional[dict] = None) -> dict:
+    """JSON-ready summary: ``optimum``, ``objective``, ``converged`` (the CLI's contract),
+    and the study, message, objectives' values, constraints, counts, time, arb rates
+    written, the output ``files`` and the ``history``."""
+    study = result.study
+    return {
+        "study": study.name,
+        "optimum": result.optimum,
+        "objective": result.objective,
+        "converged": result.converged,
+        "failed": result.failed,
+        "message": result.message,
+        "values": result.values,
+        "units": {_label(s, study.specs): OBJECTIVES[s.name].units for s in study.specs},
+        "constraints": result.constraints,
+        "variables": {v.name: {"path": v.path, "lower": v.lower, "upper": v.upper, "initial": v.initial,
+                               "log": v.log, "units": v.units} for v in study.variables},
+        "modes": study.modes,
+        "method": study.optimiser["method"],
+        "iterations": result.iterations,
+        "evaluations": result.evaluations,
+        "wall_s": result.wall_s,
+        "car_values": changed_car_values(result),
+        "files": files or {},
+        "history": result.history,
+    }
+
+
+def changed_car_values(result: OptimisationResult) -> dict:
+    """``{path: value}`` (SI) of the car-file values (:data:`CAR_FILE_KEYS`) that differ
+    between the study's base car and the optimum."""
+    base = vehicle.load_car(result.study.vehicle, modes=0).params  # the bars, coupling, rack: as any mode count
+    out = {}
+    for path in CAR_FILE_KEYS:
+        new = float(get_at(result.car.params, path))
+        if new != float(get_at(base, path)):
+            out[path] = new
+    return out
+
+
+def _car_text(study: OptimisationStudy) -> str:
+    if study.vehicle is None:
+        return (resources.files("jaxveh.params") / "data" / "car.toml").read_text()
+    return Path(study.vehicle).read_text()
+
+
+def _set_value(text: str, section: str, key: str, value: str) -> str:
+    """``text`` (TOML) with ``key = value`` in ``[section]``: the value of an existing line
+    replaced (its comment kept), or a line added after the section's header."""
+    lines = text.splitlines(keepends=True)
+    header = re.compile(rf"^\s*\[{re.escape(section)}\]\s*(#.*)?$")
+    start = next((i for i, line in enumerate(lines) if header.match(line.rstrip("\n"))), None)
+    if start is None:
+        return text.rstrip("\n") + f"\n\n[{section}]\n{key} = {value}\n"
+    end = next((i for i in range(start + 1, len(lines)) if re.match(r"^\s*\[", lines[i])), len(lines))
+    pattern = re.compile(rf"^(\s*{re.escape(key)}\s*=\s*)([^#\n]*?)(\s*(#.*)?)$")
+    for i in range(start + 1, end):
+        m = pattern.match(lines[i].rstrip("\n"))
+        if m:
+            lines[i] = f"{m.group(1)}{value}{m.group(3)}\n"
+            return "".join(lines)
+    lines.insert(start + 1, f"{key} = {value}\n")
+    return "".join(lines)
+
+
+def optimum_car_file(result: OptimisationResult) -> str:
+    """The base car file's text with the optimum's changed values written in (only those,
+    in the file's units; :data:`CAR_FILE_KEYS`), its ``[files]`` made absolute where they
+    were paths relative to the base file, and a header naming the study. A car file for
+    ``--vehicle``."""
+    study = result.study
+    text = _car_text(study)
+    changed = changed_car_values(result)
+    for path, value in changed.items():
+        section, key, unit = CAR_FILE_KEYS[path]
+        text = _set_value(text, section, key, repr(value / UNIT_TO_SI[unit]))
+    if study.vehicle is not None:  # tyre and frame files relative to the base file: absolute in the copy
+        files = read_car_file(study.vehicle).files
+        for key, name in files.items():
+            if Path(name).is_file() and not Path(name).is_absolute():
+                text = _set_value(text, "files", key, json.dumps(str(Path(name).resolve())))
+    unwritten = [v.path for v in study.variables if v.path != "lambda" and v.path not in CAR_FILE_KEYS]
+    head = [f"# The optimum of the study {study.name!r} ({study.file or 'built in Python'}), written by jaxveh "
+            "optimise:", "# " + ", ".join(f"{k} = {v:.10g}" for k, v in result.optimum.items()) +
+            f" (converged: {str(result.converged).lower()})"]
+    if unwritten:
+        head.append("# Not in a car file (set them with --param): " + ", ".join(
+            f"{p} = {float(get_at(result.car.params, p)):.10g}" for p in unwritten))
+    return "\n".join(head) + "\n" + text
+
+
+def write_outputs(result: OptimisationResult, out_dir=None) -> dict:
+    """Write ``OUT/NAME.json`` (:func:`result_report`), ``OUT/NAME_history.csv`` (one row
+    per iteration) and ``OUT/NAME_car.toml`` (:func:`optimum_car_file`; not after a failed
+    run); returns ``{kind: path}``."""
+    out = Path(result.study.out if out_dir is None else out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    name = result.study.name
+    files = {"json": str(out / f"{name}.json"), "csv": str(out / f"{name}_history.csv")}
+    columns = list(dict.fromkeys(k for entry in result.history for k in entry))
+    with open(files["csv"], "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns)
+        writer.writeheader()
+        writer.writerows(result.history)
+    if not result.failed:
+        files["vehicle"] = str(out / f"{name}_car.toml")
+        Path(files["vehicle"]).write_text(optimum_car_file(result))
+    report = result_report(result, files)
+    Path(files["json"]).write_text(json.dumps(report, indent=2))
+    return files
