@@ -75,6 +75,8 @@ MAX_POINTS = {"car": 4096, "analytic": 1_000_000}
 MAX_CHUNK = 65536
 #: Backends that run the chunks.
 BACKENDS = ("local", "ray")
+#: Name of the car model's convergence flag in the Dataset (a data variable beside the quantities).
+CONVERGED = "converged"
 #: Default points per chunk, per model.
 DEFAULT_CHUNK = {"car": 16, "analytic": 256}
 
@@ -268,6 +270,9 @@ def check_study(study: Study) -> Study:
                        f"{study.model!r}: {', '.join(known)}")
     if len(set(study.quantities)) != len(study.quantities) or set(study.quantities) & set(names):
         raise _err(where, "study.quantities", "repeat a quantity or a variable name: each name once")
+    if study.model == "car" and CONVERGED in names:
+        raise _err(where, "variables", f"use the name {CONVERGED!r}, which the car's convergence flag has: "
+                   "choose another name")
     if study.n_points > MAX_POINTS[study.model]:
         raise _err(where, "variables", f"give {study.n_points} grid points ({' x '.join(map(str, study.shape))}): "
                    f"more than the maximum of {MAX_POINTS[study.model]} for model = {study.model!r}")

@@ -28,6 +28,7 @@ import hashlib
 import json
 import os
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import NamedTuple, Optional
@@ -43,10 +44,8 @@ import jaxveh.analytic as analytic
 from jaxveh import ParameterError, analysis, vehicle
 from jaxveh.params import check_analytic_vehicle, get_at, load_analytic_vehicle, set_all, set_at
 
-from ._study import LABELS, QUANTITIES, Study, check_study
+from ._study import CONVERGED, LABELS, QUANTITIES, Study, check_study
 
-#: Name of the car model's convergence flag in the Dataset.
-CONVERGED = "converged"
 #: File of the chunk manifest inside ``OUT/chunks``.
 MANIFEST = "manifest.json"
 #: netCDF engine (the one :func:`jaxveh.manoeuvre.write_netcdf` uses: SciPy, netCDF3).
@@ -226,7 +225,8 @@ def car_designs(car, study: Study, points: np.ndarray):
     rates = np.zeros((points.shape[0], 2))
     for key in dict.fromkeys(keys):
         rows = np.asarray([j for j, kk in enumerate(keys) if kk == key])
-        design = eqx.tree_at(lambda c: c.params, car, jax.tree.map(lambda x, r=rows[0]: x[r], stacked))
+        one = jax.tree.map(lambda x, r=rows[0]: x[r] if eqx.is_array(x) else x, stacked)
+        design = eqx.tree_at(lambda c: c.params, car, one)
         rates[rows] = np.asarray(analysis.arb_rates_for_distribution(design, jnp.asarray(points[rows, k])))
     return eqx.tree_at(lambda p: p.arb_rates, stacked, jnp.asarray(rates))
 
@@ -349,9 +349,15 @@ def _progress(enabled: bool, total: int, description: str):
     return progress, progress.add_task(description, total=total)
 
 
+def _chunk_points(study: Study, start: int, stop: int) -> np.ndarray:
+    """A chunk's points padded to the one chunk shape (``chunk`` rows, or all the points when
+    the grid is smaller than a chunk)."""
+    return _pad(grid_points(study, start, stop), min(study.chunk, study.n_points))
+
+
 def _run_local(study, todo, evaluate, done):
     for index, (start, stop) in todo:
-        points = _pad(grid_points(study, start, stop), study.chunk)
+        points = _chunk_points(study, start, stop)
         values = evaluate(points)
         done(index, {k: np.asarray(v)[: stop - start] for k, v in values.items()})
 
@@ -362,8 +368,7 @@ def _worker_chunk(study: Study, start: int, stop: int, cache_dir: Optional[str])
     if cache_dir and not jax.config.jax_compilation_cache_dir:
         jax.config.update("jax_compilation_cache_dir", cache_dir)
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
-    points = _pad(grid_points(study, start, stop), study.chunk)
-    values = build_model(study).evaluate(points)
+    values = build_model(study).evaluate(_chunk_points(study, start, stop))
     return {k: np.asarray(v)[: stop - start] for k, v in values.items()}
 
 
@@ -374,10 +379,13 @@ def _run_ray(study, todo, done):
         raise ParameterError(f"{study.where('run.backend')} = 'ray' needs Ray: pip install 'jaxveh[cluster]'") from None
     started = False
     if not ray.is_initialized():
-        if study.address:
-            ray.init(address=study.address, log_to_driver=False)
-        else:
-            ray.init(num_cpus=study.num_cpus, include_dashboard=False, log_to_driver=False)
+        with warnings.catch_warnings():
+            # Ray starts its processes by fork + exec, which JAX's fork warning cannot tell apart.
+            warnings.filterwarnings("ignore", message="os.fork", category=RuntimeWarning)
+            if study.address:
+                ray.init(address=study.address, log_to_driver=False)
+            else:
+                ray.init(num_cpus=study.num_cpus, include_dashboard=False, log_to_driver=False)
         started = True
     try:
         task = ray.remote(num_cpus=1)(_worker_chunk)
