@@ -2,6 +2,46 @@
 constraints, solved with Optax (augmented Lagrangian around a gradient optimiser); study
 files and sensitivity maps at scale (``sweep``: chunked vmap, checkpoints, Ray)."""
 
+from ._objectives import (
+    FRAME_OBJECTIVES as FRAME_OBJECTIVES,
+    OBJECTIVES as OBJECTIVES,
+    SOURCES as SOURCES,
+    Objective as Objective,
+    ObjectiveSpec as ObjectiveSpec,
+    arb_rates_for_lambda as arb_rates_for_lambda,
+    camber_gradient as camber_gradient,
+    chassis_mass as chassis_mass,
+    chi as chi,
+    first_mode_damping_ratio as first_mode_damping_ratio,
+    first_mode_frequency as first_mode_frequency,
+    first_mode_reference as first_mode_reference,
+    matched_eigenvalue as matched_eigenvalue,
+    objective_spec as objective_spec,
+    objective_values as objective_values,
+    rear_steer_gradient as rear_steer_gradient,
+    roll_gradient as roll_gradient,
+    roll_rate_coefficients as roll_rate_coefficients,
+    state_matrix as state_matrix,
+    steering_sensitivity as steering_sensitivity,
+    torsional_stiffness as torsional_stiffness,
+    understeer_gradient as understeer_gradient,
+)
+from ._optimise_study import (
+    CAR_FILE_KEYS as CAR_FILE_KEYS,
+    METHODS as METHODS,
+    Design as Design,
+    DesignVariable as DesignVariable,
+    OptimisationError as OptimisationError,
+    OptimisationResult as OptimisationResult,
+    OptimisationStudy as OptimisationStudy,
+    build_design as build_design,
+    design_car as design_car,
+    load_optimisation_study as load_optimisation_study,
+    optimise_study as optimise_study,
+    optimum_car_file as optimum_car_file,
+    result_report as result_report,
+    write_outputs as write_outputs,
+)
 from ._problem import (
     Problem as Problem,
     Result as Result,

@@ -482,7 +482,13 @@ def design_car(design: Design, values: dict):
     return design.problem.apply(design.problem.params, {k: jnp.asarray(v, jnp.float64) for k, v in values.items()})[0]
 
 
-def _values_and_jacobian(z, problem, specs, prepared):
+def _values_and_jacobian(z, base, variables, apply, specs, prepared):
+    """Every objective's value at the unconstrained design ``z`` and the exact Jacobian
+    ``d values / d z`` (forward mode). The terms' targets, scales and weights are applied on
+    the host (:func:`_merit`), so they are not part of the compiled program: studies that
+    differ only in them share it."""
+    problem = Problem(params=base, variables=variables, objective=_StudyObjective((), specs), apply=apply)
+
     def values(z):
         car, _ = problem.build(z)
         v = objective_values(car, specs, prepared)
@@ -525,9 +531,9 @@ def build_design(study: OptimisationStudy) -> Design:
     def evaluate(z):
         if cacheable:
             with run_time_checks_off():
-                v, jac = _compiled(jnp.asarray(z), problem, specs, prepared)
+                v, jac = _compiled(jnp.asarray(z), problem.params, problem.variables, apply, specs, prepared)
         else:
-            v, jac = _compiled(jnp.asarray(z), problem, specs, prepared)
+            v, jac = _compiled(jnp.asarray(z), problem.params, problem.variables, apply, specs, prepared)
         return np.asarray(v), np.asarray(jac)
 
     return Design(car=car, problem=problem, specs=specs, prepared=prepared, evaluate=evaluate)
