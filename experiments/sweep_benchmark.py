@@ -48,8 +48,11 @@ def _run(study: Study) -> float:
 
 def _pair(make, n_points: int) -> dict:
     first, warm = _run(make("first")), _run(make("warm"))
-    return {"first_s": round(first, 3), "warm_s": round(warm, 3), "evals_per_s_first": round(n_points / first, 1),
-            "evals_per_s_warm": round(n_points / warm, 1)}
+    def sig(x):
+        return float(f"{x:.4g}")
+
+    return {"first_s": sig(first), "warm_s": sig(warm), "evals_per_s_first": sig(n_points / first),
+            "evals_per_s_warm": sig(n_points / warm)}
 
 
 def main() -> None:

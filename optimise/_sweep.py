@@ -210,24 +210,31 @@ def _analytic_model(study: Study) -> Model:
     return Model(base=base, evaluate=evaluate)
 
 
-def car_designs(car, study: Study, points: np.ndarray):
+def car_designs(car, study: Study, points: np.ndarray, memo: Optional[dict] = None):
     """Stacked ``CarParams`` of the grid ``points`` (``(n, n_variables)``): the path
     variables set by one vmapped :func:`jaxveh.params.set_all`, then λ through the anti-roll
-    bars on the car with each point's other values (one call per distinct set of them)."""
+    bars on the car with each point's other values: one vectorised
+    :func:`jaxveh.analysis.arb_rates_for_distribution` call per distinct set of them, for
+    every λ of the grid at once, kept in ``memo`` (a dict the caller keeps between chunks)."""
     paths, labels = _split(study)
     pts = jnp.asarray(points, jnp.float64)
     stacked = eqx.filter_vmap(lambda x: set_all(car.params, {p: x[i] for i, p in paths}))(pts)
     if "lambda" not in labels:
         return stacked
+    memo = {} if memo is None else memo
     k = labels["lambda"]
     others = [i for i, _ in paths]
-    keys = [tuple(row) for row in np.asarray(points)[:, others]]
-    rates = np.zeros((points.shape[0], 2))
+    points = np.asarray(points, np.float64)
+    keys = [tuple(row) for row in points[:, others]]
     for key in dict.fromkeys(keys):
-        rows = np.asarray([j for j, kk in enumerate(keys) if kk == key])
-        one = jax.tree.map(lambda x, r=rows[0]: x[r] if eqx.is_array(x) else x, stacked)
-        design = eqx.tree_at(lambda c: c.params, car, one)
-        rates[rows] = np.asarray(analysis.arb_rates_for_distribution(design, jnp.asarray(points[rows, k])))
+        rows = [j for j, kk in enumerate(keys) if kk == key]
+        if any((key, points[j, k]) not in memo for j in rows):
+            lams = np.union1d(study.variables[k].values, points[rows, k])
+            one = jax.tree.map(lambda x, r=rows[0]: x[r] if eqx.is_array(x) else x, stacked)
+            design = eqx.tree_at(lambda c: c.params, car, one)
+            rates = np.asarray(analysis.arb_rates_for_distribution(design, jnp.asarray(lams)))
+            memo.update({(key, lam): r for lam, r in zip(lams, rates)})
+    rates = np.stack([memo[(key, points[j, k])] for j, key in enumerate(keys)])
     return eqx.tree_at(lambda p: p.arb_rates, stacked, jnp.asarray(rates))
 
 
@@ -238,11 +245,13 @@ def _car_model(study: Study) -> Model:
     for i, _ in paths:
         _check_path(study, i, car.params, check)
 
+    memo = {}  # anti-roll-bar rates by (other values, λ): one call per distinct other values
+
     def evaluate(points):
         points = np.asarray(points, np.float64)
         n = points.shape[0]
         size = _batch_size(n)
-        designs = _shard(car_designs(car, study, _pad(points, size)), size)
+        designs = _shard(car_designs(car, study, _pad(points, size), memo), size)
         lt = analysis.load_transfer_batch(car, designs, study.ay_g, study.radius)
         out = {"chi": np.asarray(lt.chi_low_ay)[:n]}
         out[CONVERGED] = np.asarray(jnp.all(lt.ok, axis=-1)).astype(np.int8)[:n]

@@ -38,10 +38,10 @@ def _table(report: dict) -> None:
 
 def sweep(
     study: Path = typer.Argument(..., help="Study file (TOML; see docs/optimise.md)."),
-    backend: Optional[str] = typer.Option(None, help="local or ray (default: the file's [run] backend)."),
+    backend: Optional[str] = typer.Option(None, help="local or ray (default: run.backend of the file)."),
     address: Optional[str] = typer.Option(None, help="Ray cluster address (default: start Ray locally)."),
     num_cpus: Optional[int] = typer.Option(None, "--num-cpus", help="CPUs of a locally started Ray."),
-    out: Optional[Path] = typer.Option(None, help="Output folder (default: the file's [run] out)."),
+    out: Optional[Path] = typer.Option(None, help="Output folder (default: run.out of the file)."),
     chunk: Optional[int] = typer.Option(None, help="Points per compiled call."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: dataset, n_points, ..."),
 ) -> None:
