@@ -44,7 +44,15 @@ def _markdown(report: dict) -> str:
 def main():
     out = output_dir("table_7_2", __doc__)
     jax.config.update("jax_compilation_cache_dir", str(out / "jax-cache"))
-    report = simplification_study(load_car(modes=6, form="library"), load_car(modes=0, form="library"))
+    done = {}
+
+    def progress(name, row):  # each finished row at once: the whole table takes long to compile
+        done[name] = row
+        write_json(done, out / "table_7_2_partial.json")
+        print(f"{name}: {row['steps']} steps, {row['wall_s']:.2f} s", flush=True)
+
+    report = simplification_study(load_car(modes=6, form="library"), load_car(modes=0, form="library"),
+                                  on_variant=progress)
     report["thesis_cpu_s"] = THESIS_STEP_STEER_S
     write_json(report, out / "table_7_2.json")
     (out / "table_7_2.md").write_text(_markdown(report))

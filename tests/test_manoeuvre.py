@@ -22,6 +22,7 @@ from jaxveh.manoeuvre import (
     SweptSine,
     run_dataset,
     simulate,
+    start_trim,
     steady_state,
     step_steer,
     step_steer_metrics,
@@ -190,6 +191,19 @@ def test_step_steer_physics(runs):
         np.testing.assert_allclose(ay, v * r / GRAVITY, rtol=2e-3)
         assert abs(ch["speed"][-1] - 25.0) < 0.05
         assert 0.5 < ay < 1.5
+
+
+@pytest.mark.slow
+def test_a_given_trim_is_where_the_run_starts():
+    """``simulate(..., trim=start_trim(...))`` is the same run as the default (after the
+    fixture, its compiled programs serve); a trim of the other form is refused by name."""
+    car = load_car(modes=0)
+    m = step_steer(angle=ANGLE, duration=COMPARED)
+    given = _channels(simulate(car, m, rtol=TIGHT, trim=start_trim(car, m.speed)))
+    for name, value in _channels(simulate(car, m, rtol=TIGHT)).items():
+        np.testing.assert_array_equal(given[name], value, err_msg=name)
+    with pytest.raises(ParameterError, match="trim is a fast car's straight running: pass one of the library form"):
+        simulate(car, m, form="library", trim=start_trim(car, m.speed))
 
 
 #: Channels that change sign in the mirror image of a run (the rest keep it).

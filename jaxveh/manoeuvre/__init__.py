@@ -52,6 +52,7 @@ from ._simulate import (
     manoeuvre_channels as manoeuvre_channels,
     save_times as save_times,
     simulate as simulate,
+    start_trim as start_trim,
     straight_trim as straight_trim,
 )
 from ._steady import (

@@ -272,6 +272,29 @@ def _compiled_trim(car, speed, form):
     return trim, trim.static.ok
 
 
+def start_trim(car, speed, form: str | None = None):
+    """The straight-running state at ``speed`` (m/s) that :func:`simulate` starts ``car``
+    from in ``form`` (default the car's own): compiled (disk-cached) and checked; raises
+    :class:`jaxveh.vehicle.SetupError` when its Newton solve does not converge."""
+    form = check_form(car.form if form is None else form)
+    check_car(car)
+    with run_time_checks_off():
+        trim, ok = _compiled_trim(car, speed, form)
+    if not bool(ok):
+        raise SetupError(f"the {form} car's straight running at {float(speed):g} m/s was not found "
+                         "(the powertrain's torque against drag and rolling resistance?)")
+    return trim
+
+
+def _check_trim(trim, form: str):
+    """Whether a given trim (of ``form``) converged; a trim of the other form is refused."""
+    library = hasattr(trim, "static")
+    if library != (form == "library"):
+        raise ParameterError(f"trim is a {'library' if library else 'fast'} car's straight running: pass one of "
+                             f"the {form} form (straight_trim(car, speed, {form!r}))")
+    return trim.static.ok if library else trim.ok
+
+
 def save_times(manoeuvre: Manoeuvre, points: int):
     """``points`` evenly spaced save times over the manoeuvre (s)."""
     return jnp.linspace(0.0, manoeuvre.duration, points)
@@ -279,7 +302,7 @@ def save_times(manoeuvre: Manoeuvre, points: int):
 
 def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "tsit5",
              rtol: float = 1e-4, atol: float | None = None, max_steps: int = 100_000, throw: bool = True,
-             freeze_steps: int = 0) -> CarRun:
+             freeze_steps: int = 0, trim=None) -> CarRun:
     """Run ``manoeuvre`` on ``car`` (compiled once per car structure and solver) and return a
     :class:`CarRun` with ``points`` save times. ``form``: "fast" or "library" (default: the
     car's own, ``car.form``). ``rtol``/``atol``: the PID step-size controller's tolerances
@@ -288,8 +311,10 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     ``stop_reason`` names the event and its time). A failed solve raises ``RuntimeError``
     naming the last time reached (``throw=False``: the run is returned with ``status`` 2).
     ``freeze_steps`` (library form, Table 7.2 studies): see :func:`manoeuvre_channels`.
-    After a stop the channels hold their last reached values (``valid`` marks the save
-    times reached)."""
+    ``trim``: start from this straight-running state (:func:`straight_trim` of a car with the
+    same coordinates in the same form at the manoeuvre's speed, e.g. the complete model's
+    for a simplified one) instead of the car's own. After a stop the channels hold their last
+    reached values (``valid`` marks the save times reached)."""
     form = check_form(car.form if form is None else form)
     _solver(solver)
     if not (isinstance(points, int) and points >= 2):
@@ -305,7 +330,10 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     check_car(car)  # here, so that the programs need no run-time checks (the disk cache keeps them)
     start = time.perf_counter()
     with run_time_checks_off():
-        trim, trim_ok = _compiled_trim(car, manoeuvre.speed, form)
+        if trim is None:
+            trim, trim_ok = _compiled_trim(car, manoeuvre.speed, form)
+        else:
+            trim_ok = _check_trim(trim, form)
         if not bool(trim_ok):
             raise SetupError(f"the {form} car's straight running at {float(manoeuvre.speed):g} m/s was not found "
                              "(the powertrain's torque against drag and rolling resistance?)")
