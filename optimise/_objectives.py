@@ -43,6 +43,7 @@ from jaxveh.analysis import (
     SKID_PAD_RADIUS,
     first_chassis_mode,
     linear_field,
+    linearise,
     load_transfer_core,
     root_locus,
 )
@@ -61,11 +62,12 @@ MIN_MODE_HZ = 1e-3
 
 
 class RollRateCoefficients(NamedTuple):
-    """What λ = kF / (kF + kR) needs of the car (N m/rad): the springs' roll stiffness per
-    axle ``springs_front``/``springs_rear``, the bar roll stiffness per unit bar rate
-    ``(dθ/dz t)^2`` per axle ``bar_front``/``bar_rear`` (m^2/rad... per N m/rad of bar) and
-    the car's total roll stiffness ``total``; from :func:`jaxveh.vehicle.car_rates` and
-    :func:`jaxveh.vehicle.installation_ratios` (NumPy set-up, not traceable)."""
+    """What λ = kF / (kF + kR) needs of the car: the springs' roll stiffness per axle
+    ``springs_front``/``springs_rear`` and the car's total roll stiffness ``total`` (N m/rad
+    of roll), and the roll stiffness per unit bar rate ``(dθ/dz t)^2`` per axle
+    ``bar_front``/``bar_rear`` (N m/rad of roll per N m/rad of bar twist); from
+    :func:`jaxveh.vehicle.car_rates` and :func:`jaxveh.vehicle.installation_ratios` (NumPy
+    set-up, not traceable)."""
 
     springs_front: jax.Array
     springs_rear: jax.Array
@@ -263,8 +265,8 @@ def first_mode_reference(car, speed_kmh=DEFAULT_SPEED_KMH) -> np.ndarray:
         raise ParameterError("the first coupled chassis mode needs coupling > 0: the car's coupling is 0")
     locus = root_locus(car, "coupling", np.asarray([0.0, coupling]), speed=speed_kmh / 3.6)
     j = first_chassis_mode(locus, car)
-    a, _ = jax.jit(state_matrix)(car, speed_kmh)
-    lam, vec = np.linalg.eig(np.asarray(a))
+    # the same state matrix as state_matrix's, from the program the locus compiled
+    lam, vec = np.linalg.eig(np.asarray(linearise(car, speed_kmh / 3.6).a))
     target = locus.eigenvalues[-1, j]
     return vec[:, int(np.argmin(np.abs(lam - target)))]
 
