@@ -53,7 +53,6 @@ from ._load_transfer import (
     MU_RANGE as MU_RANGE,
     SKID_PAD_RADIUS as SKID_PAD_RADIUS,
     LoadTransfer as LoadTransfer,
-    _transfers,
     arb_rates_for_distribution as arb_rates_for_distribution,
     chi_by_modes as chi_by_modes,
     chi_mode_stiffness_gradient as chi_mode_stiffness_gradient,
@@ -63,6 +62,7 @@ from ._load_transfer import (
     lambda_designs as lambda_designs,
     load_transfer as load_transfer,
     load_transfer_batch as load_transfer_batch,
+    load_transfer_core as load_transfer_core,
     mode_stiffness_designs as mode_stiffness_designs,
     truncation_designs as truncation_designs,
 )
@@ -91,10 +91,3 @@ from ._simplifications import (
     table_7_2_step_steer as table_7_2_step_steer,
     variant_car as variant_car,
 )
-
-
-def load_transfer_core(car, ay, radius, max_steps: int = 64) -> LoadTransfer:
-    """The pure core of :func:`load_transfer_batch` for one car (jit, vmap, grad; no checks):
-    its :class:`LoadTransfer` from the left and right steady turns at every ``ay`` (m/s^2,
-    an array, > 0) on ``radius`` (m), ``max_steps`` Newton steps each."""
-    return _transfers(car, ay, radius, max_steps)

@@ -97,6 +97,13 @@ def _transfers(car, ay, radius, max_steps: int = MAX_STEPS) -> LoadTransfer:
                         diff_right=d_right, ok=res.ok[:n] & res.ok[n:])
 
 
+def load_transfer_core(car, ay, radius, max_steps: int = MAX_STEPS) -> LoadTransfer:
+    """The pure core of :func:`load_transfer_batch` for one car (jit, vmap, grad; no checks):
+    its :class:`LoadTransfer` from the left and right steady turns at every ``ay`` (m/s^2,
+    an array, > 0) on ``radius`` (m), ``max_steps`` Newton steps each."""
+    return _transfers(car, ay, radius, max_steps)
+
+
 def _incremental(front, rear):
     d_front, d_rear = front[..., 1] - front[..., 0], rear[..., 1] - rear[..., 0]
     return d_front / (d_front + d_rear)
