@@ -697,8 +697,14 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
             else:
                 direction = -step
                 slope = float(grad @ direction)
-                if not slope < 0.0:  # not a descent direction: restart from steepest descent
-                    direction, slope = -grad, -float(grad @ grad)
+                if not slope < 0.0:
+                    # not a descent direction (negative curvature seen): forget the pairs and
+                    # restart as L-BFGS's first step, -g min(1, 1/|g|)
+                    with jax.numpy_dtype_promotion("standard"):
+                        state = opt.init(jnp.asarray(ev.z))
+                        updates, state = opt.update(jnp.asarray(grad), state, jnp.asarray(ev.z))
+                    direction = -np.asarray(updates)
+                    slope = float(grad @ direction)
                 t, accepted = 1.0, None
                 for _ in range(MAX_HALVINGS):
                     trial = evaluate(ev.z + t * direction)
