@@ -70,7 +70,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import optax
-import tomllib
 
 from jaxveh import ParameterError, vehicle
 from jaxveh._core import run_time_checks_off
@@ -88,7 +87,18 @@ from ._objectives import (
     roll_rate_coefficients,
 )
 from ._problem import Problem, Variable
-from ._study import LABELS, Study, SweepVariable, _check_keys, _err, _is_number, _positive_int, _variable, check_study
+from ._study import (
+    LABELS,
+    Study,
+    SweepVariable,
+    _check_keys,
+    _err,
+    _is_number,
+    _positive_int,
+    _variable,
+    check_study,
+    read_study_file,
+)
 from ._sweep import _check_path
 
 #: Optimisation methods.
@@ -364,13 +374,7 @@ def load_optimisation_study(path, *, out=None) -> OptimisationStudy:
     allowed; the paths into CarParams and the bounds' ranges are checked on the car when it
     is built (:func:`build_design`)."""
     path = Path(path)
-    if not path.is_file():
-        raise ParameterError(f"study file {str(path)!r} not found")
-    where = str(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise ParameterError(f"{where}: not valid TOML: {e}") from None
+    where, data = read_study_file(path)
     _check_keys(where, "file", data, _KEYS["file"])
     for section in ("study", "optimiser", "run"):
         if not isinstance(data.get(section, {}), dict):

@@ -297,19 +297,25 @@ def check_study(study: Study) -> Study:
     return study
 
 
+def read_study_file(path) -> tuple[str, dict]:
+    """``(where, table)``: the study file ``path`` read as TOML, ``where`` its name for
+    messages; ``ParameterError`` when it is missing or not valid TOML."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"study file {str(path)!r} not found")
+    try:
+        return str(path), tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise ParameterError(f"{path}: not valid TOML: {e}") from None
+
+
 def load_study(path, *, backend=None, address=None, out=None, chunk=None, num_cpus=None) -> Study:
     """The study of the TOML file ``path`` (module docs), with any of the run settings
     overridden (the CLI's options). ``ParameterError`` naming the file and key for anything
     not allowed; paths into the pytree are checked when the model is built
     (:func:`optimise.build_model`)."""
     path = Path(path)
-    if not path.is_file():
-        raise ParameterError(f"study file {str(path)!r} not found")
-    where = str(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise ParameterError(f"{where}: not valid TOML: {e}") from None
+    where, data = read_study_file(path)
     _check_keys(where, "file", data, tuple(_KEYS))
     sections = {}
     for section in ("study", "run"):
