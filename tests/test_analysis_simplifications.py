@@ -37,6 +37,8 @@ def test_study_refusals_are_named(car):
         an.simplification_study(load_car(modes=0, form="library"))
     with pytest.raises(ParameterError, match="rigid has 1 modes: pass the car loaded with modes = 0"):
         an.simplification_study(car, rigid=car)
+    with pytest.raises(ParameterError, match="repeats = 0 is out of range: allowed integers >= 1"):
+        an.simplification_study(car, repeats=0)
     with pytest.raises(ParameterError, match="freeze_steps = 0 is out of range: allowed integers >= 1"):
         an.simplification_study(car, freeze_steps=0)
     with pytest.raises(ParameterError, match="manoeuvre steers by RampSteer: the study needs a step steer"):
