@@ -7,7 +7,7 @@ chunks of ``study.chunk`` points; the last chunk is padded with copies of the gr
 point, so every call has one shape and the car's evaluation compiles once. With several
 local devices each chunk's points are sharded across them (the batch is padded to a
 multiple of the device count). Every finished chunk is written to
-``OUT/chunks/chunk_XXXX.npz`` beside ``OUT/chunks/manifest.json`` (the grid's hash and the
+``OUT/chunks/chunk_NNNN.npz`` (NNNN the chunk's number) beside ``OUT/chunks/manifest.json`` (the grid's hash and the
 chunk size): a rerun reads the chunks there and computes only the missing ones, and refuses
 a folder that holds another grid or another chunk size. ``backend = "ray"`` ships the chunks
 as Ray tasks (a local ``ray.init`` or a cluster's ``address``); the workers run the same
