@@ -71,8 +71,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from jaxveh import ParameterError, vehicle
-from jaxveh._core import run_time_checks_off
+from jaxveh import ParameterError, run_time_checks_off, vehicle
 from jaxveh.params import UNIT_TO_SI, get_at, read_car_file, set_all
 from jaxveh.vehicle import CORNERS
 
