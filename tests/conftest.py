@@ -25,6 +25,7 @@ from pathlib import Path
 
 import jax
 import pytest
+from jax import monitoring
 
 import jaxveh  # noqa: F401  (enables float64)
 
@@ -37,6 +38,38 @@ jax.config.update("jax_compilation_cache_max_size", 8 * 2**30)
 jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 _MAPS, _MAX_MAPS = Path("/proc/self/maps"), Path("/proc/sys/vm/max_map_count")
+
+#: Seconds each module took on a cold cache (both workers busy, 2-core machine; the modules
+#: under a minute are left out). Modules run heaviest first, so that with ``-n 2 --dist
+#: loadfile --no-loadscope-reorder`` the last module to start is a short one (longest
+#: processing time first); within a module the order is the file's. Re-measure with
+#: ``--durations=0`` (or ``JAXVEH_COMPILE_LOG``) when a module's cost changes a lot.
+MODULE_SECONDS = {}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Heaviest modules first (a stable sort: each module's own order is kept)."""
+    items.sort(key=lambda item: -MODULE_SECONDS.get(item.path.name, 0.0))
+
+
+_COMPILE_LOG = os.environ.get("JAXVEH_COMPILE_LOG")
+_current_test = ["(collection)"]
+
+if _COMPILE_LOG:
+
+    def _log_compile_phase(event: str, duration: float, **kwargs):
+        """Append ``test, phase, seconds`` for each tracing, lowering, XLA compilation and
+        disk-cache retrieval (tab-separated) to the file ``$JAXVEH_COMPILE_LOG``."""
+        if event.endswith("_duration") or "compilation_cache" in event:
+            with open(_COMPILE_LOG, "a") as f:
+                f.write(f"{_current_test[0]}\t{event.rsplit('/', 1)[-1]}\t{duration:.3f}\n")
+
+    monitoring.register_event_duration_secs_listener(_log_compile_phase)
+
+
+def pytest_runtest_setup(item):
+    """Name the test whose set-up (module fixtures included), call and teardown compile."""
+    _current_test[0] = item.nodeid
 
 
 def _release():

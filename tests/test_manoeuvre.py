@@ -145,15 +145,23 @@ def _channels(run):
     return {k: np.asarray(v) for k, v in run.channels.items() if k != "constraint_residual"}
 
 
+#: Channels compared on a shared scale: the two horizontal accelerations are components of
+#: one vector (at constant speed ``ax`` is about 1 % of ``ay``, and integration errors of
+#: the size allowed on ``ay`` would be 1e-3 of ``ax`` alone).
+SHARED_SCALE = {"ax": ("ax", "ay"), "ay": ("ax", "ay")}
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("modes", [6, 0])
 def test_step_steer_fast_equals_library(runs, modes):
+    """Every channel of the two forms agrees to 1e-5 of its largest value (accelerations:
+    of the horizontal acceleration's, :data:`SHARED_SCALE`) at rtol 1e-8."""
     fast, lib = _channels(runs[modes, "fast, compared"]), _channels(runs[modes, "library"])
     assert set(fast) == set(UNITS)
     for name in fast:
         if lib[name].size == 0:
             continue  # the rigid car's modal coordinates
-        scale = np.max(np.abs(lib[name]))
+        scale = max(np.max(np.abs(lib[k])) for k in SHARED_SCALE.get(name, (name,)))
         assert np.max(np.abs(fast[name] - lib[name])) <= 1e-5 * scale, name
 
 
