@@ -44,7 +44,33 @@ _MAPS, _MAX_MAPS = Path("/proc/self/maps"), Path("/proc/sys/vm/max_map_count")
 #: loadfile --no-loadscope-reorder`` the last module to start is a short one (longest
 #: processing time first); within a module the order is the file's. Re-measure with
 #: ``--durations=0`` (or ``JAXVEH_COMPILE_LOG``) when a module's cost changes a lot.
-MODULE_SECONDS = {}
+MODULE_SECONDS = {
+    "test_manoeuvre_fourpost.py": 2117,
+    "test_manoeuvre.py": 1655,
+    "test_vehicle_car.py": 1398,
+    "test_optimise_car.py": 801,
+    "test_analysis_load_transfer.py": 693,
+    "test_vehicle_rigs.py": 534,
+    "test_manoeuvre_steady.py": 477,
+    "test_vehicle_fast.py": 472,
+    "test_manoeuvre_driver.py": 364,
+    "test_multibody_engine.py": 346,
+    "test_optimise_sweep.py": 312,
+    "test_analysis_kinematics.py": 299,
+    "test_multibody_flexible.py": 281,
+    "test_multibody_imex.py": 262,
+    "test_manoeuvre_frequency.py": 221,
+    "test_vehicle_corner.py": 125,
+    "test_manoeuvre_ramp.py": 120,
+    "test_multibody_pendulum.py": 111,
+    "test_fe_grad.py": 105,
+    "test_analytic_dynamics.py": 103,
+    "test_plots_layout.py": 99,
+    "test_multibody_simplifications.py": 81,
+    "test_tyre_magic_formula.py": 70,
+    "test_analytic_linear.py": 63,
+    "test_vehicle_suspension.py": 60,
+}
 
 
 def pytest_collection_modifyitems(config, items):
