@@ -92,10 +92,9 @@ if _COMPILE_LOG:
 
     monitoring.register_event_duration_secs_listener(_log_compile_phase)
 
-
-def pytest_runtest_setup(item):
-    """Name the test whose set-up (module fixtures included), call and teardown compile."""
-    _current_test[0] = item.nodeid
+    def pytest_runtest_setup(item):
+        """Name the test whose set-up (module fixtures included), call and teardown compile."""
+        _current_test[0] = item.nodeid
 
 
 def _release():
