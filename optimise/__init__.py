@@ -51,6 +51,21 @@ from ._problem import (
     solve as solve,
     target as target,
 )
+from ._stiffness import (
+    Handling as Handling,
+    ModeRequirement as ModeRequirement,
+    StiffnessResult as StiffnessResult,
+    StiffnessStudy as StiffnessStudy,
+    build_handling as build_handling,
+    handling_core as handling_core,
+    is_stiffness_study as is_stiffness_study,
+    load_stiffness_study as load_stiffness_study,
+    plot_stiffness_requirement as plot_stiffness_requirement,
+    relative_deviation as relative_deviation,
+    stiffness_report as stiffness_report,
+    stiffness_requirement as stiffness_requirement,
+    write_stiffness_outputs as write_stiffness_outputs,
+)
 from ._study import (
     BACKENDS as BACKENDS,
     LABELS as LABELS,

@@ -417,17 +417,23 @@ def load_optimisation_study(path, *, out=None) -> OptimisationStudy:
                              description=description, file=where)
 
 
+def vehicle_path(where: str, path: Path, vehicle_file) -> Optional[str]:
+    """The car file ``vehicle_file`` of the study file ``path`` (relative to it) as an
+    absolute path, None for the shipped car; ``ParameterError`` when it is not a file."""
+    if vehicle_file is None:
+        return None
+    if not isinstance(vehicle_file, str):
+        raise _err(where, "study.vehicle", f"= {vehicle_file!r} is not allowed: a file path")
+    resolved = Path(vehicle_file) if Path(vehicle_file).is_absolute() else path.parent / vehicle_file
+    if not resolved.is_file():
+        raise _err(where, "study.vehicle", f"= {vehicle_file!r}: file {str(resolved)!r} not found")
+    return str(resolved.resolve())
+
+
 def _sweep_study(where, path: Path, study_t: dict, variables) -> Study:
     """The sweep :class:`~optimise.Study` with the same car and variables (values: the
     bounds and the initial value), for the sweep loader's and model builder's checks."""
-    vehicle_file = study_t.get("vehicle")
-    if vehicle_file is not None:
-        if not isinstance(vehicle_file, str):
-            raise _err(where, "study.vehicle", f"= {vehicle_file!r} is not allowed: a file path")
-        resolved = Path(vehicle_file) if Path(vehicle_file).is_absolute() else path.parent / vehicle_file
-        if not resolved.is_file():
-            raise _err(where, "study.vehicle", f"= {vehicle_file!r}: file {str(resolved)!r} not found")
-        vehicle_file = str(resolved.resolve())
+    vehicle_file = vehicle_path(where, path, study_t.get("vehicle"))
     sweep_vars = tuple(SweepVariable(name=v.name, path=v.path, values=tuple(sorted({v.lower, v.initial, v.upper})),
                                      units=v.units, log=v.log) for v in variables)
     return Study(name="s", model="car", variables=sweep_vars, quantities=("chi",), vehicle=vehicle_file,

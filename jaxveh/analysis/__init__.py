@@ -52,6 +52,7 @@ from ._load_transfer import (
     LOW_AY_PAIR_G as LOW_AY_PAIR_G,
     MU_RANGE as MU_RANGE,
     SKID_PAD_RADIUS as SKID_PAD_RADIUS,
+    FREEZE as FREEZE,
     LoadTransfer as LoadTransfer,
     arb_rates_for_distribution as arb_rates_for_distribution,
     chi_by_modes as chi_by_modes,

@@ -45,16 +45,65 @@ def _table(report: dict) -> None:
         console.print(f"{kind}: {path}")
 
 
+def _stiffness_table(report: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console()
+    table = Table(title=f"{report['study']}: within {report['tolerance'] * 100:g} % of the rigid car at lambda = "
+                        f"{', '.join(f'{x:g}' for x in report['lambda'])} ({report['evaluations']} designs, "
+                        f"{report['wall_s']:.0f} s)")
+    for column in ("mode", "mu_min", "f_min (Hz)", "f at mu = 1 (Hz)", "binding", "status"):
+        table.add_column(column)
+    for m in report["per_mode"]:
+        mu = "-" if m["mu_min"] is None else f"{m['mu_min']:.4g}"
+        f = "-" if m["frequency_hz"] is None else f"{m['frequency_hz']:.1f}"
+        binding = "" if m["binding_quantity"] is None else f"{m['binding_quantity']} at lambda {m['binding_lambda']:g}"
+        table.add_row(str(m["mode"]), mu, f, f"{m['nominal_frequency_hz']:.1f}", binding, m["status"])
+    console.print(table)
+    joint = report["joint"]
+    if joint is not None and joint["factor"] is not None:
+        console.print(f"all modes at their minima: worst deviation {joint['worst_deviation_at_minima']}; common "
+                      f"factor {joint['factor']:.4g} -> mu = {[round(m, 4) for m in joint['mu']]}")
+    for kind, path in report["files"].items():
+        console.print(f"{kind}: {path}")
+
+
+def _stiffness(opt, study: Path, out: Optional[Path], as_json: bool) -> None:
+    try:
+        spec = opt.load_stiffness_study(study, out=out)
+        if not as_json:
+            typer.echo(f"jaxveh optimise: {spec.name}, how stiff is stiff enough ({spec.modes} modes) -> {spec.out} "
+                       "(the first run compiles the car: minutes)", err=True)
+        result = opt.stiffness_requirement(spec, progress=None if as_json else (lambda s: typer.echo(s, err=True)))
+    except ParameterError as e:
+        fail(str(e))
+    except RuntimeError as e:
+        typer.echo(f"error: {e}", err=True)
+        raise typer.Exit(code=1) from None
+    files = opt.write_stiffness_outputs(result)
+    report = opt.stiffness_report(result) | {"files": files}
+    if as_json:
+        emit_json(report)
+    else:
+        _stiffness_table(report)
+
+
 def optimise(
-    study: Path = typer.Argument(..., help="Optimisation study file (TOML; see docs/objectives.md)."),
+    study: Path = typer.Argument(..., help="Study file (TOML; see docs/objectives.md): an optimisation, or a "
+                                           "stiffness requirement (a [requirement] table)."),
     out: Optional[Path] = typer.Option(None, help="Output folder (default: the file's [run] out)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: optimum, objective, converged, ..."),
 ) -> None:
     """Optimise a study's design variables; write OUT/NAME.json, OUT/NAME_history.csv and the
-    optimum's car file OUT/NAME_car.toml."""
+    optimum's car file OUT/NAME_car.toml. A stiffness-requirement study (how stiff is stiff
+    enough) writes OUT/NAME.json and OUT/NAME.png."""
     _compilation_cache()
     import optimise as opt
 
+    if opt.is_stiffness_study(study):
+        _stiffness(opt, study, out, as_json)
+        return
     try:
         spec = opt.load_optimisation_study(study, out=out)
         names = [v.name for v in spec.variables]
