@@ -34,6 +34,7 @@ from ._optimise_study import (
     OptimisationError as OptimisationError,
     OptimisationResult as OptimisationResult,
     OptimisationStudy as OptimisationStudy,
+    ParetoSweep as ParetoSweep,
     build_design as build_design,
     design_car as design_car,
     load_optimisation_study as load_optimisation_study,
@@ -41,6 +42,12 @@ from ._optimise_study import (
     optimum_car_file as optimum_car_file,
     result_report as result_report,
     write_outputs as write_outputs,
+)
+from ._pareto import (
+    ParetoResult as ParetoResult,
+    pareto_front as pareto_front,
+    pareto_report as pareto_report,
+    write_pareto_outputs as write_pareto_outputs,
 )
 from ._problem import (
     Problem as Problem,

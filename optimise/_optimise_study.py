@@ -121,12 +121,13 @@ CAR_FILE_KEYS = {
 }
 
 _KEYS = {
-    "file": ("study", "variables", "objective", "objectives", "constraints", "optimiser", "run"),
+    "file": ("study", "variables", "objective", "objectives", "constraints", "optimiser", "pareto", "run"),
     "study": ("name", "description", "model", "vehicle", "modes"),
     "variables": ("path", "name", "units", "lower", "upper", "initial", "log"),
     "term": ("name", "target", "minimise", "maximise", "scale", "weight"),
     "constraint": ("name", "<=", ">=", "scale"),
     "optimiser": tuple(DEFAULT_OPTIMISER),
+    "pareto": ("constraint", "values"),
     "run": ("out",),
 }
 
@@ -184,8 +185,18 @@ class Bound(NamedTuple):
         return 1.0 if self.kind == "<=" else -1.0
 
 
+class ParetoSweep(NamedTuple):
+    """An ε-constraint sweep: the bound ``constraint`` (index into the study's
+    constraints) takes each of ``values`` in turn (the constraint's units), one optimisation
+    each (:func:`optimise.pareto_front`)."""
+
+    constraint: int
+    values: tuple
+
+
 class OptimisationStudy(NamedTuple):
-    """A loaded optimisation study file (module docs); ``file`` for messages."""
+    """A loaded optimisation study file (module docs); ``file`` for messages; ``pareto``:
+    an optional :class:`ParetoSweep`."""
 
     name: str
     variables: tuple[DesignVariable, ...]
@@ -198,6 +209,7 @@ class OptimisationStudy(NamedTuple):
     out: str = "results/study"
     description: str = ""
     file: Optional[str] = None
+    pareto: Optional[ParetoSweep] = None
 
     @property
     def specs(self) -> tuple[ObjectiveSpec, ...]:
@@ -356,6 +368,28 @@ def _optimiser(where: str, table) -> dict:
     return out
 
 
+def _pareto(where: str, table, constraints) -> Optional[ParetoSweep]:
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise _err(where, "pareto", "is not a table: write a [pareto] section")
+    _check_keys(where, "pareto", table, _KEYS["pareto"])
+    name = table.get("constraint")
+    matches = [j for j, c in enumerate(constraints) if c.spec.name == name]
+    if len(matches) != 1:
+        names = ", ".join(c.spec.name for c in constraints) or "none"
+        raise _err(where, "pareto.constraint", f"= {name!r} is not allowed: the name of exactly one bound of "
+                   f"[[constraints]] (its bound takes each of pareto.values); the bounds: {names}")
+    values = table.get("values")
+    if not isinstance(values, list) or len(values) < 2 or not all(_is_number(v) for v in values):
+        raise _err(where, "pareto.values", f"= {values!r} is not allowed: a list of at least 2 numbers (the "
+                   "constraint's bounds, in its units)")
+    if not (all(b > a for a, b in zip(values, values[1:])) or all(b < a for a, b in zip(values, values[1:]))):
+        raise _err(where, "pareto.values", f"= {values!r} is not allowed: strictly monotonic (each optimisation "
+                   "starts from the previous optimum)")
+    return ParetoSweep(constraint=matches[0], values=tuple(float(v) for v in values))
+
+
 def _check_lambda(where: str, variables) -> None:
     if "lambda" not in [v.path for v in variables]:
         return
@@ -400,6 +434,7 @@ def load_optimisation_study(path, *, out=None) -> OptimisationStudy:
             raise _err(where, "objectives", "is not a non-empty array of tables: write [[objectives]] tables")
         terms = tuple(_term(where, f"objectives[{i}]", t, weighted=True) for i, t in enumerate(data["objectives"]))
     constraints = _constraints(where, data.get("constraints", []))
+    pareto = _pareto(where, data.get("pareto"), constraints)
     optimiser = _optimiser(where, data.get("optimiser", {}))
     name = study_t.get("name", path.stem)
     if not isinstance(name, str) or not re.match(r"^[A-Za-z0-9_.-]+$", name):
@@ -414,7 +449,7 @@ def load_optimisation_study(path, *, out=None) -> OptimisationStudy:
     sweep = check_study(_sweep_study(where, path, study_t, variables))
     return OptimisationStudy(name=name, variables=variables, terms=terms, constraints=constraints,
                              optimiser=optimiser, vehicle=sweep.vehicle, modes=sweep.modes, model=model, out=out,
-                             description=description, file=where)
+                             description=description, file=where, pareto=pareto)
 
 
 def vehicle_path(where: str, path: Path, vehicle_file) -> Optional[str]:

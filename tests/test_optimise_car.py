@@ -236,6 +236,46 @@ def test_cli_contract_and_car_file(design, known, tmp_path):
     assert ku == pytest.approx(known[0], abs=1e-5)
 
 
+def _roll(design, lam):
+    """The study's roll gradient (deg/g) at λ (its second objective), values only."""
+    return float(design.evaluate(np.asarray(design.problem.to_z({"lambda": lam})))[0][1])
+
+
+@pytest.mark.slow
+def test_epsilon_constraint_front(design, known, tmp_path):
+    """The ε-constraint sweep of the roll-gradient bound: a loose bound leaves the target's
+    λ (brentq's, 1e-4); a bound below the roll gradient there is active at the optimum and
+    moves λ to where the roll gradient equals it (brentq on the forward model, 1e-4),
+    i.e. the feasible λ nearest the target's (ku falls monotonically with λ here); files
+    and the CLI's JSON agree."""
+    target, lam_star, path = known
+    lam_active = lam_star - 0.03
+    roll_star, eps = _roll(design, lam_star), _roll(design, lam_active)
+    assert eps < roll_star - 1e-3, "the roll gradient must rise with lambda here for this test's bracket"
+    text = path.read_text() + f'\n[pareto]\nconstraint = "roll_gradient"\nvalues = [{roll_star + 0.5!r}, {eps!r}]\n'
+    pareto_path = _write(tmp_path, text, "front.toml")
+    study = optimise.load_optimisation_study(pareto_path, out=tmp_path / "out")
+    assert study.pareto == optimise.ParetoSweep(constraint=0, values=(roll_star + 0.5, eps))
+    front = optimise.pareto_front(study, design=design)
+    loose, tight = front.results
+    assert loose.converged and tight.converged, (loose.message, tight.message)
+    assert abs(loose.optimum["lambda"] - lam_star) < LAMBDA_TOL
+    root = scipy.optimize.brentq(lambda x: _roll(design, x) - eps, 0.3005, lam_star, xtol=1e-12)
+    assert abs(tight.optimum["lambda"] - root) < LAMBDA_TOL
+    report = optimise.pareto_report(front)
+    assert [p["active"] for p in report["points"]] == [False, True]
+    assert report["points"][1]["constrained_value"] == pytest.approx(eps, abs=1e-5)
+    assert report["points"][1]["objective"] > report["points"][0]["objective"]
+    files = optimise.write_pareto_outputs(front)
+    assert json.loads(open(files["json"]).read())["points"][1]["bound"] == eps
+    assert len(open(files["csv"]).read().splitlines()) == 3
+    res = CliRunner().invoke(app, ["optimise", str(pareto_path), "--out", str(tmp_path / "cli"), "--json"])
+    assert res.exit_code == 0, res.output
+    cli = json.loads(res.stdout)
+    assert [p["optimum"]["lambda"] for p in cli["points"]] == pytest.approx(
+        [r.optimum["lambda"] for r in front.results], abs=1e-9)
+
+
 # ---- bad study files ----------------------------------------------------------------------------
 
 GOOD = """
@@ -277,6 +317,14 @@ target = 0.1
      "cannot be varied together with lambda"),
     ("[objective]", "[[variables]]\npath = 'coupling'\nlower = 0.1\nupper = 0.9\nstart = 1\n[objective]",
      "variables.start is not a known key: allowed keys of [variables] are path, name, units, lower, upper"),
+    ("target = 0.1", 'target = 0.1\n[pareto]\nconstraint = "chi"\nvalues = [0.4, 0.5]',
+     "pareto.constraint = 'chi' is not allowed: the name of exactly one bound of [[constraints]]"),
+    ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"\n">=" = 0.3\n"<=" = 0.6\n[pareto]\n'
+     'constraint = "chi"\nvalues = [0.4, 0.5]', "the bounds: chi, chi"),
+    ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"\n"<=" = 0.6\n[pareto]\n'
+     'constraint = "chi"\nvalues = [0.4, 0.5, 0.45]', "pareto.values = [0.4, 0.5, 0.45] is not allowed: strictly"),
+    ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"\n"<=" = 0.6\n[pareto]\n'
+     'constraint = "chi"\nvalues = [0.4]\nsteps = 3', "pareto.steps is not a known key"),
 ])
 def test_bad_study_files_are_refused_by_name(tmp_path, old, new, match):
     assert old in GOOD

@@ -89,6 +89,35 @@ def _stiffness(opt, study: Path, out: Optional[Path], as_json: bool) -> None:
         _stiffness_table(report)
 
 
+def _pareto(opt, spec, as_json: bool) -> None:
+    c = spec.constraints[spec.pareto.constraint]
+    if not as_json:
+        typer.echo(f"jaxveh optimise: {spec.name}, epsilon-constraint front over {c.spec.name} {c.kind} "
+                   f"{', '.join(f'{v:g}' for v in spec.pareto.values)} -> {spec.out}", err=True)
+    front = opt.pareto_front(spec, progress=None if as_json else (lambda s: typer.echo("  " + s, err=True)))
+    files = opt.write_pareto_outputs(front)
+    report = opt.pareto_report(front) | {"files": files}
+    if as_json:
+        emit_json(report)
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"{spec.name}: objective against {c.spec.name} {c.kind} bound ({front.wall_s:.0f} s)")
+    names = [v.name for v in spec.variables]
+    for column in ("bound", "objective", c.spec.name, *names, "active", "status"):
+        table.add_column(column)
+    for p in report["points"]:
+        status = "failed" if p["failed"] else "converged" if p["converged"] else "not converged"
+        fmt = lambda x: "-" if x is None else f"{x:.6g}"  # noqa: E731
+        table.add_row(f"{p['bound']:g}", fmt(p["objective"]), fmt(p["constrained_value"]),
+                      *(fmt(p["optimum"][n]) for n in names), str(p["active"]), status)
+    console = Console()
+    console.print(table)
+    for kind, path in files.items():
+        console.print(f"{kind}: {path}")
+
+
 def optimise(
     study: Path = typer.Argument(..., help="Study file (TOML; see docs/objectives.md): an optimisation, or a "
                                            "stiffness requirement (a [requirement] table)."),
@@ -106,6 +135,9 @@ def optimise(
         return
     try:
         spec = opt.load_optimisation_study(study, out=out)
+        if spec.pareto is not None:
+            _pareto(opt, spec, as_json)
+            return
         names = [v.name for v in spec.variables]
         if not as_json:
             typer.echo(f"jaxveh optimise: {spec.name}, {spec.modes} modes, {', '.join(names)} by "
