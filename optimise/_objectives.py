@@ -147,10 +147,17 @@ def _camber_gradient(pad, corner="front_left"):
     return _nan_unless(pad.ok[0], pad.gradients["camber"][0, _corner_index(corner)] * GRAVITY)
 
 
+#: The rear-steer objective's ``corner`` naming the rear axle: the mean of both rear wheels.
+REAR_AXLE = "rear"
+
+
 def _rear_steer_gradient(pad, corner="rear_left"):
-    if not corner.startswith("rear"):
-        raise ParameterError(f"corner = {corner!r} is not allowed: rear_left or rear_right (the front wheels steer)")
-    return _nan_unless(pad.ok[0], pad.gradients["road_wheel_angle"][0, _corner_index(corner)] * GRAVITY)
+    if corner != REAR_AXLE and not corner.startswith("rear"):
+        raise ParameterError(f"corner = {corner!r} is not allowed: rear_left, rear_right or rear (the axle's mean; "
+                             "the front wheels steer)")
+    angles = pad.gradients["road_wheel_angle"][0]
+    angle = jnp.mean(angles[2:]) if corner == REAR_AXLE else angles[_corner_index(corner)]
+    return _nan_unless(pad.ok[0], angle * GRAVITY)
 
 
 def understeer_gradient(car, ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
@@ -185,7 +192,9 @@ def camber_gradient(car, corner="front_left", ay_g=DEFAULT_AY_G, radius=SKID_PAD
 def rear_steer_gradient(car, corner="rear_left", ay_g=DEFAULT_AY_G, radius=SKID_PAD_RADIUS):
     """Steer (toe) gradient of the rear wheel ``corner`` (deg/g; road-wheel angle, positive
     left) at ``ay_g`` (g) on ``radius`` (m): roll steer, compliance steer and the chassis's
-    deformation together."""
+    deformation together. ``corner = "rear"``: the rear axle's, the mean of both wheels
+    (in a turn the outer wheel's travel, and so its roll steer, is the larger: the car
+    also heaves)."""
     return _rear_steer_gradient(skid_pad_point(car, ay_g, radius), corner)
 
 
@@ -367,7 +376,7 @@ OBJECTIVES = {
     "camber_gradient": Objective(camber_gradient, "deg/g", "camber change per g of one wheel (corner) at ay_g, "
                                  "everything included", "skid_pad", _camber_gradient, {"corner": "front_left"}),
     "rear_steer_gradient": Objective(rear_steer_gradient, "deg/g", "road-wheel angle change per g of a rear "
-                                     "wheel (corner) at ay_g", "skid_pad", _rear_steer_gradient,
+                                     "wheel (corner; rear: the axle's mean) at ay_g", "skid_pad", _rear_steer_gradient,
                                      {"corner": "rear_left"}),
     "chi": Objective(chi, "1", "front share of the lateral load transfer at low ay, between the two ay_g",
                      "load_transfer", _chi),

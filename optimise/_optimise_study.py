@@ -78,6 +78,7 @@ from jaxveh.vehicle import CORNERS
 from ._objectives import (
     FRAME_OBJECTIVES,
     OBJECTIVES,
+    REAR_AXLE,
     ObjectiveSpec,
     arb_rates_for_lambda,
     objective_spec,
@@ -295,6 +296,7 @@ def _spec(where: str, key: str, table: dict, reserved) -> ObjectiveSpec:
             raise _err(where, f"{key}.{k}", f"= {v!r} is not allowed: {what} (default {default!r})")
     if "corner" in settings:
         corners = [c for c in CORNERS if name != "rear_steer_gradient" or c.startswith("rear")]
+        corners += [REAR_AXLE] if name == "rear_steer_gradient" else []
         if settings["corner"] not in corners:
             raise _err(where, f"{key}.corner", f"= {settings['corner']!r} is not allowed: one of {', '.join(corners)}")
     spec = objective_spec(name, {k: float(v) if _is_number(v) else v for k, v in settings.items()})

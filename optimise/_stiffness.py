@@ -52,7 +52,6 @@ import math
 import re
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import NamedTuple, Optional
 
@@ -249,13 +248,24 @@ def build_handling(study: StiffnessStudy) -> Handling:
     lambdas = jnp.asarray(study.lambdas, jnp.float64)
     base = np.asarray(car.params.chassis.stiffness_scale, float)
 
+    # one program per shared computation (skid-pad point, load transfer): in one program
+    # XLA's CPU runtime runs their batched LAPACK solves concurrently, each splitting its
+    # batch over the same 2-thread pool, and the 6-mode car's program deadlocked there
+    # (jaxlib 0.10.2: lapack_dtrsm_ffi -> ParallelBatchMap waiting on a full pool)
+    groups = {}
+    for q, spec in enumerate(study.quantities):
+        groups.setdefault(spec.source_key, []).append(q)
+
     def evaluate(scale):
         scale = np.asarray(scale, float)
         if scale.shape != base.shape or not np.all(np.isfinite(scale)) or not np.all(scale > 0):
             raise ParameterError(f"scale = {scale.tolist()!r} is not allowed: {base.size} finite multipliers > 0")
-        with run_time_checks_off():
-            out = _compiled_handling(car, coefficients, lambdas, jnp.asarray(scale), study.quantities)
-        return np.asarray(out)
+        out = np.empty((len(study.lambdas), len(study.quantities)))
+        for columns in groups.values():
+            specs = tuple(study.quantities[q] for q in columns)
+            with run_time_checks_off():
+                out[:, columns] = np.asarray(_compiled_handling(car, coefficients, lambdas, jnp.asarray(scale), specs))
+        return out
 
     return Handling(car=car, evaluate=evaluate, frequencies_hz=np.asarray(car.params.chassis.frequencies_hz, float),
                     base_scale=base)
@@ -333,9 +343,10 @@ def _bisect(evaluate_many, lo: float, hi: float, rtol: float, within) -> tuple[f
 
 
 def stiffness_requirement(study: StiffnessStudy, handling: Optional[Handling] = None,
-                          progress: Optional[Callable[[str], None]] = None, workers: int = 2) -> StiffnessResult:
-    """Run the study (module docs); ``progress`` receives a line per stage; ``workers``
-    compiled calls run at a time (threads: the calls release the interpreter)."""
+                          progress: Optional[Callable[[str], None]] = None) -> StiffnessResult:
+    """Run the study (module docs); ``progress`` receives a line per stage. The compiled
+    calls run one after the other: two threads executing the program at once deadlocked in
+    XLA's CPU runtime (jax 0.10.2), so no thread pool."""
     start = time.perf_counter()
     say = progress or (lambda _: None)
     h = handling if handling is not None else build_handling(study)
@@ -345,8 +356,7 @@ def stiffness_requirement(study: StiffnessStudy, handling: Optional[Handling] = 
 
     def run_all(scales):
         count[0] += len(scales)
-        with ThreadPoolExecutor(max(1, workers)) as pool:
-            return list(pool.map(h.evaluate, scales))
+        return [h.evaluate(s) for s in scales]
 
     say("rigid reference (every mode frozen) and the car as loaded")
     reference, nominal = run_all([base * FREEZE, base])

@@ -307,6 +307,8 @@ target = 0.1
     ("target = 0.1", "target = 0.1\nminimise = true", "needs exactly one of target = VALUE, minimise = true"),
     ("target = 0.1", "target = 0.1\nspeed = 3.0", "objective.speed is not a key of objective 'understeer_gradient'"),
     ("target = 0.1", 'target = 0.1\ncorner = "middle"', "objective.corner is not a key of objective"),
+    ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "rear_steer_gradient"\ncorner = "front"\n"<=" = 1.0',
+     "constraints[0].corner = 'front' is not allowed: one of rear_left, rear_right, rear"),
     ("target = 0.1", "target = 0.1\nscale = 0", "objective.scale = 0 is not allowed: a number > 0"),
     ("target = 0.1", 'target = 0.1\n[optimiser]\nmethod = "newton"',
      "optimiser.method = 'newton' is not allowed: one of lbfgs, adam"),
@@ -386,3 +388,19 @@ def test_frame_objectives_derivatives():
     fd = (f(t0 + h) - f(t0 - h)) / (2 * h)
     np.testing.assert_allclose(jvp, fd, rtol=1e-6)
     assert float(value[0]) > 0 and float(value[1]) > 0
+
+
+def test_rear_steer_gradient_of_the_axle():
+    """``corner = "rear"`` is the mean of both rear wheels' road-wheel angle gradients;
+    a front corner is refused by name, in a study file too."""
+    from types import SimpleNamespace
+
+    from optimise._objectives import _rear_steer_gradient
+
+    pad = SimpleNamespace(ok=jnp.array([True]), gradients={"road_wheel_angle": jnp.array([[9.0, 9.0, 0.01, -0.03]])})
+    assert float(_rear_steer_gradient(pad, "rear")) == pytest.approx(-0.01 * GRAVITY, rel=1e-15)
+    assert float(_rear_steer_gradient(pad, "rear_right")) == pytest.approx(-0.03 * GRAVITY, rel=1e-15)
+    with pytest.raises(ParameterError, match="corner = 'front_left' is not allowed: rear_left, rear_right or rear"):
+        _rear_steer_gradient(pad, "front_left")
+    spec = optimise.objective_spec("rear_steer_gradient", {"corner": "rear"})
+    assert dict(spec.settings)["corner"] == "rear"
