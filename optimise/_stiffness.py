@@ -12,8 +12,8 @@ the tolerance.
 The rigid reference is the same car with every mode frozen (stiffness multiplied by
 :data:`jaxveh.analysis.FREEZE`; a frozen mode's share of χ is below 1e-7, tested in
 tests/test_analysis_load_transfer.py), so the reference, the scans and the searches share
-one compiled program: the quantities of one design at every λ of the study, one vmapped
-call (:func:`handling_core`).
+the same compiled programs: the quantities of one design at every λ of the study, one
+vmapped call per shared computation (:func:`handling_core`).
 
 The search is on the forward model, not by gradients: each mode's deviation is scanned
 over a geometric grid of µ, the last grid interval where it crosses the tolerance is
@@ -229,10 +229,10 @@ _compiled_handling = eqx.filter_jit(handling_core)
 
 
 class Handling(NamedTuple):
-    """The study's model: ``evaluate(scale) -> (n_lambda, n_quantities)`` NumPy values (one
-    compiled call; NaN where a steady state failed), the ``car``, its free-free natural
-    frequencies ``frequencies_hz`` at its own multipliers and the ``base_scale`` (the car's
-    own multipliers)."""
+    """The study's model: ``evaluate(scale) -> (n_lambda, n_quantities)`` NumPy values (a
+    compiled call per shared computation; NaN where a steady state failed), the ``car``,
+    its free-free natural frequencies ``frequencies_hz`` at its own multipliers and the
+    ``base_scale`` (the car's own multipliers)."""
 
     car: object
     evaluate: Callable
