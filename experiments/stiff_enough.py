@@ -16,13 +16,9 @@ import json
 import os
 from pathlib import Path
 
-# before JAX starts: single-threaded Eigen (the 6-mode car's batched solves hang XLA's CPU
-# pool on two cores otherwise; jaxveh.cli._main.SERIAL_EIGEN)
-os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " --xla_cpu_multi_thread_eigen=false").strip()
+import jax
 
-import jax  # noqa: E402
-
-import optimise  # noqa: E402
+import optimise
 
 STUDY = Path(__file__).with_name("studies") / "stiff_enough.toml"
 

@@ -12,8 +12,8 @@ the tolerance.
 The rigid reference is the same car with every mode frozen (stiffness multiplied by
 :data:`jaxveh.analysis.FREEZE`; a frozen mode's share of χ is below 1e-7, tested in
 tests/test_analysis_load_transfer.py), so the reference, the scans and the searches share
-the same compiled programs: the quantities of one design at every λ of the study, one
-vmapped call per shared computation (:func:`handling_core`).
+the same compiled programs: the quantities of one design at one λ, a program per shared
+computation (:func:`handling_core`).
 
 The search is on the forward model, not by gradients: each mode's deviation is scanned
 over a geometric grid of µ, the last grid interval where it crosses the tolerance is
@@ -56,7 +56,6 @@ from pathlib import Path
 from typing import NamedTuple, Optional
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -210,29 +209,25 @@ def load_stiffness_study(path, *, out=None) -> StiffnessStudy:
 # ---- the model --------------------------------------------------------------------------------
 
 
-def handling_core(car, coefficients, lambdas, scale, specs):
-    """The quantities ``specs`` of ``car`` with the modal stiffness multipliers ``scale``
-    (``chassis.stiffness_scale``) at every roll stiffness distribution of ``lambdas`` (set
-    through the bars by :func:`optimise.arb_rates_for_lambda` with ``coefficients``):
-    ``(n_lambda, n_quantities)``, NaN where a steady state failed. Pure; one vmapped call."""
+def handling_core(car, coefficients, lam, scale, specs):
+    """The quantities ``specs`` (one array, :func:`optimise.objective_values`) of ``car``
+    with the modal stiffness multipliers ``scale`` (``chassis.stiffness_scale``) at the
+    roll stiffness distribution ``lam`` (set through the bars by
+    :func:`optimise.arb_rates_for_lambda` with ``coefficients``); NaN where a steady state
+    failed. Pure."""
     params = eqx.tree_at(lambda p: p.chassis.stiffness_scale, car.params, scale)
-
-    def one(lam):
-        design = eqx.tree_at(lambda c: c.params, car,
-                             eqx.tree_at(lambda p: p.arb_rates, params, arb_rates_for_lambda(coefficients, lam)))
-        return objective_values(design, specs)
-
-    return jax.vmap(one)(lambdas)
+    params = eqx.tree_at(lambda p: p.arb_rates, params, arb_rates_for_lambda(coefficients, lam))
+    return objective_values(eqx.tree_at(lambda c: c.params, car, params), specs)
 
 
 _compiled_handling = eqx.filter_jit(handling_core)
 
 
 class Handling(NamedTuple):
-    """The study's model: ``evaluate(scale) -> (n_lambda, n_quantities)`` NumPy values (a
-    compiled call per shared computation; NaN where a steady state failed), the ``car``,
-    its free-free natural frequencies ``frequencies_hz`` at its own multipliers and the
-    ``base_scale`` (the car's own multipliers)."""
+    """The study's model: ``evaluate(scale) -> (n_lambda, n_quantities)`` NumPy values
+    (NaN where a steady state failed), the ``car``, its free-free natural frequencies
+    ``frequencies_hz`` at its own multipliers and the ``base_scale`` (the car's own
+    multipliers)."""
 
     car: object
     evaluate: Callable
@@ -241,17 +236,18 @@ class Handling(NamedTuple):
 
 
 def build_handling(study: StiffnessStudy) -> Handling:
-    """Load the study's car and prepare its compiled model (:class:`Handling`)."""
+    """Load the study's car and prepare its compiled model (:class:`Handling`).
+
+    One compiled call per λ and per shared computation (skid-pad point, load transfer),
+    not one vmapped call: batched over λ, XLA's CPU runtime ran the designs' LAPACK
+    triangular solves concurrently, each splitting its batch over the same 2-thread pool
+    and waiting for it, and the 6-mode car's program hung (jaxlib 0.10.2, ``lapack_dtrsm_ffi``
+    in ``ParallelBatchMap``; single-threaded Eigen did not help). Unbatched, every solve
+    runs in place."""
     car = vehicle.load_car(study.vehicle, modes=study.modes)
     vehicle.check_car(car)
     coefficients = roll_rate_coefficients(car)
-    lambdas = jnp.asarray(study.lambdas, jnp.float64)
     base = np.asarray(car.params.chassis.stiffness_scale, float)
-
-    # one program per shared computation (skid-pad point, load transfer): in one program
-    # XLA's CPU runtime runs their batched LAPACK solves concurrently, each splitting its
-    # batch over the same 2-thread pool, and the 6-mode car's program deadlocked there
-    # (jaxlib 0.10.2: lapack_dtrsm_ffi -> ParallelBatchMap waiting on a full pool)
     groups = {}
     for q, spec in enumerate(study.quantities):
         groups.setdefault(spec.source_key, []).append(q)
@@ -261,10 +257,12 @@ def build_handling(study: StiffnessStudy) -> Handling:
         if scale.shape != base.shape or not np.all(np.isfinite(scale)) or not np.all(scale > 0):
             raise ParameterError(f"scale = {scale.tolist()!r} is not allowed: {base.size} finite multipliers > 0")
         out = np.empty((len(study.lambdas), len(study.quantities)))
-        for columns in groups.values():
-            specs = tuple(study.quantities[q] for q in columns)
-            with run_time_checks_off():
-                out[:, columns] = np.asarray(_compiled_handling(car, coefficients, lambdas, jnp.asarray(scale), specs))
+        for j, lam in enumerate(study.lambdas):
+            for columns in groups.values():
+                specs = tuple(study.quantities[q] for q in columns)
+                with run_time_checks_off():
+                    out[j, columns] = np.asarray(_compiled_handling(car, coefficients, jnp.asarray(lam),
+                                                                    jnp.asarray(scale), specs))
         return out
 
     return Handling(car=car, evaluate=evaluate, frequencies_hz=np.asarray(car.params.chassis.frequencies_hz, float),

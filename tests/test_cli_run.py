@@ -4,7 +4,6 @@ section's pieces are tested in the manoeuvre and vehicle modules)."""
 
 import json
 
-import pytest
 from typer.testing import CliRunner
 
 from jaxveh.cli import app
@@ -42,30 +41,3 @@ def test_report_puts_the_car_beside_the_thesis():
     assert "| roll at 1 g, deg | 2.01 | 2.01 | about 2 |" in report
     assert "| front share of load transfer at 1 g | n/a | n/a |" in report  # beyond the curve
     assert "![skid-pad](car_skid_pad.png)" in report and "30.0, 40.0 Hz" in report
-
-
-def test_console_entry_runs_with_single_threaded_eigen(monkeypatch):
-    """``jaxveh`` (the console script) re-executes itself once with the Eigen flag in
-    XLA_FLAGS, keeping the user's other flags, and runs the app directly when the flag is
-    there (either value: the user's choice)."""
-    from jaxveh.cli import _main
-
-    calls = []
-
-    def execve(path, argv, env):  # the process is replaced: nothing after it runs
-        calls.append((path, argv, env))
-        raise SystemExit(0)
-
-    monkeypatch.setattr(_main.os, "execve", execve)
-    monkeypatch.setattr(_main, "app", lambda: calls.append("app"))
-    monkeypatch.setattr(_main.sys, "argv", ["jaxveh", "optimise", "s.toml", "--json"])
-    monkeypatch.setenv("XLA_FLAGS", "--xla_dump_to=/tmp/x")
-    with pytest.raises(SystemExit):
-        _main.main()
-    (path, argv, env), = calls
-    assert env["XLA_FLAGS"] == "--xla_dump_to=/tmp/x " + _main.SERIAL_EIGEN
-    assert argv[-3:] == ["optimise", "s.toml", "--json"] and argv[1] == "-c"
-    calls.clear()
-    monkeypatch.setenv("XLA_FLAGS", "--xla_cpu_multi_thread_eigen=true")
-    _main.main()
-    assert calls == ["app"]

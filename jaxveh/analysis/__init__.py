@@ -47,12 +47,12 @@ from ._linear import (
 )
 from ._load_transfer import (
     AY_GRID_G as AY_GRID_G,
+    FREEZE as FREEZE,
     LAMBDA_RANGE as LAMBDA_RANGE,
     LOW_AY_G as LOW_AY_G,
     LOW_AY_PAIR_G as LOW_AY_PAIR_G,
     MU_RANGE as MU_RANGE,
     SKID_PAD_RADIUS as SKID_PAD_RADIUS,
-    FREEZE as FREEZE,
     LoadTransfer as LoadTransfer,
     arb_rates_for_distribution as arb_rates_for_distribution,
     chi_by_modes as chi_by_modes,

@@ -1,8 +1,5 @@
 """Top-level ``jaxveh`` Typer application; each sub-command group lives in its own module."""
 
-import os
-import sys
-
 import typer
 
 from ._analytic import app as analytic_app
@@ -32,21 +29,6 @@ app.add_typer(rig_app, name="rig")
 app.add_typer(simulate_app, name="simulate")
 
 
-#: The XLA flag the command line runs with: single-threaded Eigen on the CPU. With the
-#: default multi-threaded pool, batched LAPACK solves that XLA runs concurrently each split
-#: their batch over the same pool and wait for it; on a 2-core machine the pool is full of
-#: waiters and the program hangs (seen with the 6-mode car's steady states, jaxlib 0.10.2:
-#: lapack_dtrsm_ffi in ParallelBatchMap; docs/objectives.md).
-SERIAL_EIGEN = "--xla_cpu_multi_thread_eigen=false"
-
-
 def main() -> None:
-    """Console-script entry point. XLA reads its flags when JAX starts, before this runs,
-    so without the Eigen flag in ``XLA_FLAGS`` (:data:`SERIAL_EIGEN`; set it either way
-    yourself to choose) the command re-executes itself once with it."""
-    flags = os.environ.get("XLA_FLAGS", "")
-    if "xla_cpu_multi_thread_eigen" not in flags:
-        env = dict(os.environ, XLA_FLAGS=f"{flags} {SERIAL_EIGEN}".strip())
-        code = "from jaxveh.cli import app; app(prog_name='jaxveh')"
-        os.execve(sys.executable, [sys.executable, "-c", code, *sys.argv[1:]], env)
+    """Console-script entry point."""
     app()
