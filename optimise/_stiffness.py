@@ -501,12 +501,13 @@ def plot_stiffness_requirement(report: dict, path) -> Path:
                 ax.axvline(m["mu_min"], color=line.get_color(), lw=0.7, ls=":")
         ax.axhline(report["tolerance"] * 100.0, color="k", lw=0.9, ls="--", label="tolerance")
         ax.set_xlabel("stiffness multiplier µ of the mode (the others rigid)")
-        ax.set_ylabel(f"worst |{name} - rigid| / |rigid| over λ (%)")
+        ax.set_ylabel("worst relative deviation over λ (%)")
+        ax.set_title(name)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
-    fig.suptitle(f"How stiff is stiff enough: λ = {report['lambda'][0]:g}-{report['lambda'][-1]:g}, "
-                 f"tolerance {report['tolerance'] * 100:g} %")
-    fig.tight_layout()
+    fig.suptitle(f"How stiff is stiff enough: |value - rigid| / |rigid| at λ = {report['lambda'][0]:g}-"
+                 f"{report['lambda'][-1]:g}, tolerance {report['tolerance'] * 100:g} %")
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.95))
     path = Path(path)
     fig.savefig(path, dpi=150)
     plt.close(fig)
