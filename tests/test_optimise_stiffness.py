@@ -20,7 +20,7 @@ import pytest
 from typer.testing import CliRunner
 
 import optimise
-from jaxveh import ParameterError
+from jaxveh import GRAVITY, ParameterError
 from jaxveh.analysis import FREEZE, chi_by_modes
 from jaxveh.cli import app
 from jaxveh.manoeuvre import skid_pad
@@ -241,7 +241,7 @@ def test_reference_and_car_equal_the_librarys_programs(car_run):
     chi = np.asarray(chi_by_modes(MODES))
     assert result.reference[1, 0] == pytest.approx(chi[0], abs=1e-7)
     assert result.nominal[1, 0] == pytest.approx(chi[MODES], abs=1e-9)
-    ku = float(skid_pad(car, 50.0, np.array([0.05 * 9.81])).understeer_gradient[0])
+    ku = float(skid_pad(car, 50.0, np.array([0.05 * GRAVITY])).understeer_gradient[0])
     assert result.nominal[1, 1] == pytest.approx(ku, rel=1e-6)
     # the flexible car differs from the rigid one by more than the tolerance (else no question)
     assert np.max(optimise.relative_deviation(result.nominal, result.reference)) > study.tolerance
