@@ -490,13 +490,17 @@ def plot_stiffness_requirement(report: dict, path) -> Path:
     import matplotlib.pyplot as plt
 
     names = [q["name"] for q in report["quantities"]]
-    fig, axes = plt.subplots(1, len(names), figsize=(5.2 * len(names), 4.2), squeeze=False)
+    fig, axes = plt.subplots(1, len(names), figsize=(5.6 * len(names), 4.6), squeeze=False)
     mu = np.asarray(report["mu_scan"])
     for ax, name in zip(axes[0], names):
         for m in report["per_mode"]:
             dev = np.asarray([np.nan if d is None else d for d in m["scan_worst_deviation"][name]], float)
+            if m["status"] == "above_range":
+                answer = ": none in the scan"
+            else:
+                answer = f": µ ≥ {m['mu_min']:.3g}" + (" (the scan's lowest)" if m["status"] == "below_range" else "")
             line, = ax.loglog(mu, np.where(np.isfinite(dev), dev * 100.0, np.nan), "-o", ms=3,
-                              label=f"mode {m['mode']}" + (f": µ ≥ {m['mu_min']:.3g}" if m["mu_min"] else ""))
+                              label=f"mode {m['mode']}{answer}")
             if m["mu_min"] is not None and m["status"] == "found":
                 ax.axvline(m["mu_min"], color=line.get_color(), lw=0.7, ls=":")
         ax.axhline(report["tolerance"] * 100.0, color="k", lw=0.9, ls="--", label="tolerance")
@@ -505,9 +509,9 @@ def plot_stiffness_requirement(report: dict, path) -> Path:
         ax.set_title(name)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
-    fig.suptitle(f"How stiff is stiff enough: |value - rigid| / |rigid| at λ = {report['lambda'][0]:g}-"
+    fig.suptitle(f"How stiff is stiff enough: |value - rigid| / |rigid|\nat λ = {report['lambda'][0]:g}-"
                  f"{report['lambda'][-1]:g}, tolerance {report['tolerance'] * 100:g} %")
-    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.95))
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.93))
     path = Path(path)
     fig.savefig(path, dpi=150)
     plt.close(fig)

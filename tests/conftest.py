@@ -56,6 +56,7 @@ MODULE_SECONDS = {
     "test_manoeuvre_driver.py": 364,
     "test_multibody_engine.py": 346,
     "test_optimise_sweep.py": 312,
+    "test_optimise_stiffness.py": 300,
     "test_analysis_kinematics.py": 299,
     "test_multibody_flexible.py": 281,
     "test_multibody_imex.py": 262,

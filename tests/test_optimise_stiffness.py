@@ -93,7 +93,7 @@ def test_multipliers_are_relative_to_the_cars_own():
     assert result.modes[0].mu_min == pytest.approx(A[0].max() / TOL, rel=2e-4)
 
 
-def test_a_mode_never_stiff_enough_and_a_failed_design():
+def test_a_mode_never_stiff_enough_and_a_failed_design(tmp_path):
     a = A.copy()
     a[1] *= 1e5                       # mode 2 outside the tolerance even at µ = 1000
     h, _ = _synthetic(a)
@@ -113,6 +113,8 @@ def test_a_mode_never_stiff_enough_and_a_failed_design():
     report = optimise.stiffness_report(result)
     assert report["per_mode"][0]["scan_worst_deviation"]["chi"][:2] == [None, None]
     json.dumps(report, allow_nan=False)
+    files = optimise.write_stiffness_outputs(result, tmp_path)     # the figure with a mode never stiff enough
+    assert json.loads(open(files["json"]).read())["per_mode"][1]["status"] == "above_range"
 
 
 def test_failed_reference_is_reported():
