@@ -329,70 +329,74 @@ def _worst(dev: np.ndarray) -> float:
     return float(np.max(dev))
 
 
-def _bisect(evaluate_many, lo: float, hi: float, rtol: float, within) -> tuple[float, list]:
-    """Shrink ``(lo, hi)`` (lo outside, hi within the tolerance) in log until hi / lo <= 1 + rtol."""
+def _bisect(measure, lo: float, hi: float, dev_hi: np.ndarray, rtol: float, within) -> tuple:
+    """Shrink ``(lo, hi)`` (``lo`` outside the tolerance, ``hi`` within it, its deviations
+    ``dev_hi``) in log until ``hi / lo <= 1 + rtol``: ``(hi, dev_hi, [(x, deviations)])``."""
     trail = []
     while hi / lo > 1.0 + rtol:
         mid = math.sqrt(lo * hi)
-        dev = evaluate_many([mid])[0]
+        dev = measure(mid)
         trail.append((mid, dev))
-        lo, hi = (lo, mid) if within(dev) else (mid, hi)
-    return hi, trail
+        if within(dev):
+            hi, dev_hi = mid, dev
+        else:
+            lo = mid
+    return hi, dev_hi, trail
+
+
+def _binding(study: StiffnessStudy, dev: Optional[np.ndarray]) -> tuple:
+    """The quantity and λ of the largest deviation in ``dev`` (None, None without one)."""
+    if dev is None:
+        return None, None
+    j, q = np.unravel_index(np.argmax(np.where(np.isfinite(dev), dev, 1e300)), dev.shape)
+    return study.quantities[q].name, study.lambdas[j]
 
 
 def stiffness_requirement(study: StiffnessStudy, handling: Optional[Handling] = None,
                           progress: Optional[Callable[[str], None]] = None) -> StiffnessResult:
-    """Run the study (module docs); ``progress`` receives a line per stage. The compiled
-    calls run one after the other: two threads executing the program at once deadlocked in
-    XLA's CPU runtime (jax 0.10.2), so no thread pool."""
+    """Run the study (module docs); ``progress`` receives a line per stage."""
     start = time.perf_counter()
     say = progress or (lambda _: None)
     h = handling if handling is not None else build_handling(study)
     base, tol = h.base_scale, study.tolerance
-    names = [s.name for s in study.quantities]
     count = [0]
 
-    def run_all(scales):
-        count[0] += len(scales)
-        return [h.evaluate(s) for s in scales]
+    def values(scale):
+        count[0] += 1
+        return h.evaluate(scale)
 
     say("rigid reference (every mode frozen) and the car as loaded")
-    reference, nominal = run_all([base * FREEZE, base])
+    reference, nominal = values(base * FREEZE), values(base)
     if not np.all(np.isfinite(reference)):
         bad = [study.lambdas[i] for i in np.nonzero(~np.all(np.isfinite(reference), axis=1))[0]]
         raise RuntimeError(f"the rigid reference's steady state failed at lambda = {bad}: no requirement can be "
                            "measured against it")
-    deviation = lambda values: relative_deviation(values, reference)  # noqa: E731
-    within = lambda dev: _worst(dev) <= tol  # noqa: E731
 
-    n = base.size
-    scans = []
-    for i in range(n):
-        say(f"mode {i + 1}: scan of {len(study.mu)} multipliers")
-        scans.append(np.stack([deviation(v) for v in run_all([_isolated(base, i, m) for m in study.mu])]))
+    def deviation(scale):
+        return relative_deviation(values(scale), reference)
+
+    def within(dev):
+        return _worst(dev) <= tol
 
     modes = []
-    for i, scan in enumerate(scans):
-        ok = np.array([within(d) for d in scan])
-        outside = np.nonzero(~ok)[0]
+    for i in range(base.size):
+        say(f"mode {i + 1}: scan of {len(study.mu)} multipliers")
+        scan = np.stack([deviation(_isolated(base, i, m)) for m in study.mu])
+        outside = np.nonzero([not within(d) for d in scan])[0]
+        trail, last_outside = [], scan[outside[-1]] if outside.size else None
         if outside.size == 0:
-            mu_min, status, trail = study.mu[0], "below_range", []
+            mu_min, status = study.mu[0], "below_range"
         elif outside[-1] == len(study.mu) - 1:
-            mu_min, status, trail = None, "above_range", []
+            mu_min, status = None, "above_range"
         else:
             k = outside[-1]
             say(f"mode {i + 1}: bisection between mu = {study.mu[k]:.4g} and {study.mu[k + 1]:.4g}")
-            mu_min, trail = _bisect(lambda ms, i=i: [deviation(v) for v in run_all([_isolated(base, i, m)
-                                                                                    for m in ms])],
-                                    study.mu[k], study.mu[k + 1], study.rtol, within)
+            mu_min, _, trail = _bisect(lambda m, i=i: deviation(_isolated(base, i, m)), study.mu[k], study.mu[k + 1],
+                                       scan[k + 1], study.rtol, within)
             status = "found"
-        # the binding quantity and λ just below the answer (the last point outside the tolerance)
-        below = [d for m, d in trail if m < (mu_min or np.inf) and not within(d)]
-        worst = below[-1] if below else scan[outside[-1]] if outside.size else None
-        quantity = lam = None
-        if worst is not None:
-            j, q = np.unravel_index(np.argmax(np.where(np.isfinite(worst), worst, 1e300)), worst.shape)
-            quantity, lam = names[q], study.lambdas[j]
+            # the binding deviations: the last point outside the tolerance, just below the answer
+            last_outside = next((d for m, d in reversed(trail) if not within(d)), last_outside)
+        quantity, lam = _binding(study, last_outside)
         freq = None if mu_min is None else float(h.frequencies_hz[i] * math.sqrt(mu_min))
         modes.append(ModeRequirement(mode=i + 1, mu_min=mu_min, status=status, frequency_hz=freq, quantity=quantity,
                                      lam=lam, scan=scan, bisection=[(m, _worst(d)) for m, d in trail]))
@@ -401,20 +405,17 @@ def stiffness_requirement(study: StiffnessStudy, handling: Optional[Handling] = 
     if all(m.mu_min is not None for m in modes):
         mu_min = np.array([m.mu_min for m in modes])
         minima = base * mu_min
-        joint_at_minima = deviation(run_all([minima])[0])
+        joint_at_minima = deviation(minima)
         factor, joint_dev = 1.0, joint_at_minima
         if not within(joint_at_minima):
             say("all modes together: search of the common factor")
-            lo, hi, dev_hi = 1.0, 2.0, None
-            while True:
-                dev_hi = deviation(run_all([minima * hi])[0])
-                if within(dev_hi) or hi >= 2.0 ** 20:
-                    break
+            lo, hi = 1.0, 2.0
+            dev_hi = deviation(minima * hi)
+            while not within(dev_hi) and hi < 2.0**20:
                 lo, hi = hi, 2.0 * hi
+                dev_hi = deviation(minima * hi)
             if within(dev_hi):
-                factor, trail = _bisect(lambda fs: [deviation(v) for v in run_all([minima * f for f in fs])],
-                                        lo, hi, study.rtol, within)
-                joint_dev = deviation(run_all([minima * factor])[0])
+                factor, joint_dev, _ = _bisect(lambda f: deviation(minima * f), lo, hi, dev_hi, study.rtol, within)
             else:
                 factor, joint_dev = None, None
         joint_mu = None if factor is None else mu_min * factor
