@@ -155,8 +155,10 @@ def _rear_steer_gradient(pad, corner="rear_left"):
     if corner != REAR_AXLE and not corner.startswith("rear"):
         raise ParameterError(f"corner = {corner!r} is not allowed: rear_left, rear_right or rear (the axle's mean; "
                              "the front wheels steer)")
-    angles = pad.gradients["road_wheel_angle"][0]
-    angle = jnp.mean(angles[2:]) if corner == REAR_AXLE else angles[_corner_index(corner)]
+    if corner == REAR_AXLE:
+        angle = jnp.mean(pad.gradients["road_wheel_angle"][0, 2:])
+    else:
+        angle = pad.gradients["road_wheel_angle"][0, _corner_index(corner)]
     return _nan_unless(pad.ok[0], angle * GRAVITY)
 
 
