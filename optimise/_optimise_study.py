@@ -36,6 +36,10 @@ A study file::
     "<=" = 1.2
     scale = 0.1                       # the violation's scale (default 1)
 
+    [pareto]                          # optional: an ε-constraint front (optimise.pareto_front)
+    constraint = "roll_gradient"      # the name of one bound of [[constraints]] ...
+    values = [1.4, 1.2, 1.0]          # ... which takes each of these in turn (monotonic)
+
     [optimiser]
     method = "lbfgs"                  # "lbfgs" (Optax's L-BFGS direction, Armijo backtracking) or "adam"
     steps = 30                        # iterations per outer (augmented-Lagrangian) iteration
