@@ -64,6 +64,7 @@ from ._stiffness import (
     StiffnessResult as StiffnessResult,
     StiffnessStudy as StiffnessStudy,
     build_handling as build_handling,
+    check_stiffness_study as check_stiffness_study,
     handling_core as handling_core,
     is_stiffness_study as is_stiffness_study,
     load_stiffness_study as load_stiffness_study,

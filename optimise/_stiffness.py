@@ -352,9 +352,33 @@ def _binding(study: StiffnessStudy, dev: Optional[np.ndarray]) -> tuple:
     return study.quantities[q].name, study.lambdas[j]
 
 
+def check_stiffness_study(study: StiffnessStudy) -> StiffnessStudy:
+    """Check a :class:`StiffnessStudy` built in Python as its file would be checked;
+    returns it. ``ParameterError`` naming the field and what is allowed."""
+    where = study.file or "study"
+    if not (_is_number(study.tolerance) and 0 < study.tolerance < 1):
+        raise _err(where, "requirement.tolerance", f"= {study.tolerance!r} is not allowed: a number in (0, 1)")
+    if not (_is_number(study.rtol) and 1e-6 <= study.rtol <= 1):
+        raise _err(where, "requirement.rtol", f"= {study.rtol!r} is not allowed: a number in [1e-6, 1]")
+    _increasing(where, "requirement.lambda", list(study.lambdas), 0.0, 1.0)
+    if len(_increasing(where, "requirement.mu", list(study.mu), 0.0, FREEZE)) < 2:
+        raise _err(where, "requirement.mu", f"= {list(study.mu)!r} is not allowed: at least 2 multipliers")
+    if not (_is_int(study.modes) and 1 <= study.modes <= 20):
+        raise _err(where, "study.modes", f"= {study.modes!r} is not allowed: an integer 1 to 20")
+    if not study.quantities:
+        raise _err(where, "quantities", "is empty: at least one quantity")
+    for i, spec in enumerate(study.quantities):
+        if spec.name not in OBJECTIVES or OBJECTIVES[spec.name].source not in _SOURCES:
+            allowed = [n for n, o in OBJECTIVES.items() if o.source in _SOURCES]
+            raise _err(where, f"quantities[{i}].name", f"= {spec.name!r} is not allowed: one of {', '.join(allowed)}")
+    return study
+
+
 def stiffness_requirement(study: StiffnessStudy, handling: Optional[Handling] = None,
                           progress: Optional[Callable[[str], None]] = None) -> StiffnessResult:
-    """Run the study (module docs); ``progress`` receives a line per stage."""
+    """Run the study (module docs; checked first, :func:`check_stiffness_study`);
+    ``progress`` receives a line per stage."""
+    check_stiffness_study(study)
     start = time.perf_counter()
     say = progress or (lambda _: None)
     h = handling if handling is not None else build_handling(study)

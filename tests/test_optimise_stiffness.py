@@ -192,6 +192,24 @@ def test_bad_study_files_are_refused_by_name(tmp_path, change, key):
         optimise.load_stiffness_study(path)
 
 
+@pytest.mark.parametrize("change, key", [
+    ({"tolerance": 0.0}, "requirement.tolerance"),
+    ({"rtol": 2.0}, "requirement.rtol"),
+    ({"lambdas": (0.5, 0.4)}, "requirement.lambda"),
+    ({"mu": (1.0,)}, "requirement.mu"),
+    ({"mu": (1.0, -2.0)}, "requirement.mu"),
+    ({"modes": 0}, "study.modes"),
+    ({"quantities": ()}, "quantities"),
+    ({"quantities": (optimise.objective_spec("first_mode_frequency"),)}, "quantities[0].name"),
+])
+def test_a_study_built_in_python_is_checked(change, key):
+    """The Python API refuses what the file loader refuses, by name, before any evaluation."""
+    h, calls = _synthetic()
+    with pytest.raises(ParameterError, match=r"study: " + re.escape(key)):
+        optimise.stiffness_requirement(_study()._replace(**change), handling=h)
+    assert calls == []
+
+
 def test_cli_refuses_a_bad_requirement_study(tmp_path):
     path = _write(tmp_path, GOOD.replace("tolerance = 0.02", "tolerance = -1"))
     res = CliRunner().invoke(app, ["optimise", str(path), "--json"])
