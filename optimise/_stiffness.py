@@ -177,17 +177,6 @@ def load_stiffness_study(path, *, out=None) -> StiffnessStudy:
     study_t, req, run_t = data.get("study", {}), data.get("requirement", {}), data.get("run", {})
     if study_t.get("model", "car") != "car":
         raise _err(where, "study.model", f"= {study_t['model']!r} is not allowed: 'car' (the chapter-6 car)")
-    modes = study_t.get("modes", 6)
-    if not _is_int(modes) or not 1 <= modes <= 20:
-        raise _err(where, "study.modes", f"= {modes!r} is not allowed: an integer 1 to 20 (the modes whose "
-                   "stiffness is asked for; a rigid car has none)")
-    tolerance = req.get("tolerance", TOLERANCE)
-    if not _is_number(tolerance) or not 0 < tolerance < 1:
-        raise _err(where, "requirement.tolerance", f"= {tolerance!r} is not allowed: a number in (0, 1) (relative "
-                   "to the rigid car's value)")
-    rtol = req.get("rtol", RTOL)
-    if not _is_number(rtol) or not 1e-6 <= rtol <= 1:
-        raise _err(where, "requirement.rtol", f"= {rtol!r} is not allowed: a number in [1e-6, 1]")
     lambdas = _increasing(where, "requirement.lambda", req.get("lambda", list(LAMBDAS)), 0.0, 1.0)
     mu = _mu_scan(where, req)
     quantities = _quantities(where, data.get("quantities"))
@@ -200,10 +189,12 @@ def load_stiffness_study(path, *, out=None) -> StiffnessStudy:
     out = str(out) if out is not None else run_t.get("out", f"results/{name}")
     if not isinstance(out, str) or not out:
         raise _err(where, "run.out", f"= {out!r} is not allowed: a folder path")
-    return StiffnessStudy(name=name, quantities=quantities, tolerance=float(tolerance), lambdas=lambdas, mu=mu,
-                          rtol=float(rtol), vehicle=vehicle_path(where, path, study_t.get("vehicle")), modes=modes,
-                          out=out,
-                          description=description, file=where)
+    study = StiffnessStudy(name=name, quantities=quantities, tolerance=req.get("tolerance", TOLERANCE),
+                           lambdas=lambdas, mu=mu, rtol=req.get("rtol", RTOL), modes=study_t.get("modes", 6), out=out,
+                           description=description, file=where)
+    check_stiffness_study(study)  # tolerance, rtol, modes: the checks a study built in Python gets
+    return study._replace(tolerance=float(study.tolerance), rtol=float(study.rtol),
+                          vehicle=vehicle_path(where, path, study_t.get("vehicle")))
 
 
 # ---- the model --------------------------------------------------------------------------------
@@ -357,14 +348,16 @@ def check_stiffness_study(study: StiffnessStudy) -> StiffnessStudy:
     returns it. ``ParameterError`` naming the field and what is allowed."""
     where = study.file or "study"
     if not (_is_number(study.tolerance) and 0 < study.tolerance < 1):
-        raise _err(where, "requirement.tolerance", f"= {study.tolerance!r} is not allowed: a number in (0, 1)")
+        raise _err(where, "requirement.tolerance", f"= {study.tolerance!r} is not allowed: a number in (0, 1) "
+                   "(relative to the rigid car's value)")
     if not (_is_number(study.rtol) and 1e-6 <= study.rtol <= 1):
         raise _err(where, "requirement.rtol", f"= {study.rtol!r} is not allowed: a number in [1e-6, 1]")
     _increasing(where, "requirement.lambda", list(study.lambdas), 0.0, 1.0)
     if len(_increasing(where, "requirement.mu", list(study.mu), 0.0, FREEZE)) < 2:
         raise _err(where, "requirement.mu", f"= {list(study.mu)!r} is not allowed: at least 2 multipliers")
     if not (_is_int(study.modes) and 1 <= study.modes <= 20):
-        raise _err(where, "study.modes", f"= {study.modes!r} is not allowed: an integer 1 to 20")
+        raise _err(where, "study.modes", f"= {study.modes!r} is not allowed: an integer 1 to 20 (the modes whose "
+                   "stiffness is asked for; a rigid car has none)")
     if not study.quantities:
         raise _err(where, "quantities", "is empty: at least one quantity")
     for i, spec in enumerate(study.quantities):
