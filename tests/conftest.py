@@ -98,6 +98,31 @@ if _COMPILE_LOG:
         _current_test[0] = item.nodeid
 
 
+_MEMORY_LOG = os.environ.get("JAXVEH_MEMORY_LOG")
+_STATUS, _CLEAR_REFS = Path("/proc/self/status"), Path("/proc/self/clear_refs")
+
+
+def _status_kib(field: str) -> int:
+    for line in _STATUS.read_text().splitlines():
+        if line.startswith(field + ":"):
+            return int(line.split()[1])
+    return -1
+
+
+if _MEMORY_LOG and _STATUS.exists():
+
+    def pytest_runtest_logstart(nodeid, location):
+        """Reset the process's peak resident memory (VmHWM) before each test."""
+        _CLEAR_REFS.write_text("5")
+
+    def pytest_runtest_logfinish(nodeid, location):
+        """Append ``test, peak MiB, resident MiB`` (set-up, call and teardown together) to
+        the file ``$JAXVEH_MEMORY_LOG``: which tests two workers must not overlap."""
+        peak, now = _status_kib("VmHWM") // 1024, _status_kib("VmRSS") // 1024
+        with open(_MEMORY_LOG, "a") as f:
+            f.write(f"{nodeid}\t{peak}\t{now}\n")
+
+
 def _release():
     jax.clear_caches()
     gc.collect()
