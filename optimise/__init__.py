@@ -2,6 +2,14 @@
 constraints, solved with Optax (augmented Lagrangian around a gradient optimiser); study
 files and sensitivity maps at scale (``sweep``: chunked vmap, checkpoints, Ray)."""
 
+from ._frame_design import (
+    FRAME_QUANTITIES as FRAME_QUANTITIES,
+    FrameVariable as FrameVariable,
+    car_with_frame as car_with_frame,
+    load_car_frame as load_car_frame,
+    parse_frame_path as parse_frame_path,
+    set_frame_sizes as set_frame_sizes,
+)
 from ._objectives import (
     FRAME_OBJECTIVES as FRAME_OBJECTIVES,
     OBJECTIVES as OBJECTIVES,
@@ -17,6 +25,7 @@ from ._objectives import (
     first_mode_reference as first_mode_reference,
     matched_eigenvalue as matched_eigenvalue,
     objective_spec as objective_spec,
+    objective_units as objective_units,
     objective_values as objective_values,
     rear_steer_gradient as rear_steer_gradient,
     roll_gradient as roll_gradient,
@@ -29,6 +38,7 @@ from ._objectives import (
 from ._optimise_study import (
     CAR_FILE_KEYS as CAR_FILE_KEYS,
     METHODS as METHODS,
+    Bound as Bound,
     Design as Design,
     DesignVariable as DesignVariable,
     OptimisationError as OptimisationError,
@@ -40,7 +50,9 @@ from ._optimise_study import (
     load_optimisation_study as load_optimisation_study,
     optimise_study as optimise_study,
     optimum_car_file as optimum_car_file,
+    optimum_frame_file as optimum_frame_file,
     result_report as result_report,
+    rigid_values as rigid_values,
     write_outputs as write_outputs,
 )
 from ._pareto import (

@@ -388,9 +388,11 @@ OBJECTIVES = {
                                           "chassis mode about straight running at speed_kmh", "linear", _damping),
 }
 
+#: The shared computation the frame's objectives name (:attr:`ObjectiveSpec.source_key`).
+FRAME_SOURCE = "frame"
 #: Objectives of the chassis frame (functions of a :class:`jaxveh.fe.Frame`): name ->
-#: (function, units, description). Not available in car studies (their design variables
-#: are ``CarParams`` paths, which do not reach the frame's sections).
+#: (function, units, description). Available in car studies with frame variables
+#: (``frame.sections...`` paths, :mod:`optimise._frame_design`).
 FRAME_OBJECTIVES = {
     "chassis_mass": (chassis_mass, "kg", "mass of the chassis frame (FE)"),
     "torsional_stiffness": (torsional_stiffness, "N m/deg", "torsional stiffness of the chassis frame (FE torsion "
@@ -407,7 +409,10 @@ class ObjectiveSpec(NamedTuple):
 
     @property
     def source_key(self) -> tuple:
-        """``(source, settings of the source)``: objectives with one key share a computation."""
+        """``(source, settings of the source)``: objectives with one key share a computation
+        (the frame's objectives: ``("frame", ())``)."""
+        if self.name in FRAME_OBJECTIVES:
+            return FRAME_SOURCE, ()
         objective = OBJECTIVES[self.name]
         own = SOURCES[objective.source].settings
         return objective.source, tuple((k, v) for k, v in self.settings if k in own)
@@ -415,14 +420,21 @@ class ObjectiveSpec(NamedTuple):
     @property
     def options(self) -> dict:
         """The objective's own settings (beyond its source's)."""
+        if self.name in FRAME_OBJECTIVES:
+            return {}
         objective = OBJECTIVES[self.name]
         return {k: v for k, v in self.settings if k in objective.options}
 
 
-def objective_spec(name: str, settings: dict | None = None) -> ObjectiveSpec:
+def objective_spec(name: str, settings: dict | None = None, frame: bool = False) -> ObjectiveSpec:
     """An :class:`ObjectiveSpec` of ``name`` with ``settings`` over the defaults (settings
-    that are arrays, a :class:`Source`'s prepared ones, are not part of the spec).
+    that are arrays, a :class:`Source`'s prepared ones, are not part of the spec); with
+    ``frame``, the frame's objectives (:data:`FRAME_OBJECTIVES`, no settings) too.
     ``ParameterError`` for an unknown objective or setting."""
+    if frame and name in FRAME_OBJECTIVES:
+        if settings:
+            raise ParameterError(f"objective {name!r} has no setting {sorted(settings)[0]!r}: allowed none")
+        return ObjectiveSpec(name, ())
     if name not in OBJECTIVES:
         extra = " (an objective of the frame, not of the car)" if name in FRAME_OBJECTIVES else ""
         raise ParameterError(f"objective {name!r} is not known{extra}: allowed {', '.join(OBJECTIVES)}")
@@ -442,22 +454,39 @@ def prepare(car, specs) -> dict:
     out = {}
     for spec in specs:
         key = spec.source_key
+        if key[0] == FRAME_SOURCE:
+            continue
         source = SOURCES[key[0]]
         if source.prepare is not None and key not in out:
             out[key] = source.prepare(car, dict(key[1]))
     return out
 
 
-def objective_values(car, specs, prepared=None):
+def objective_values(car, specs, prepared=None, frame=None):
     """The values of the objectives ``specs`` (a tuple of :class:`ObjectiveSpec`) of ``car``
-    as one array (their units of :data:`OBJECTIVES`), each shared computation done once;
-    ``prepared``: :func:`prepare`'s arrays. Pure and differentiable; NaN where a steady
+    as one array (their units, :func:`objective_units`), each shared computation done once;
+    ``prepared``: :func:`prepare`'s arrays; ``frame``: the chassis frame, for the frame's
+    objectives (:data:`FRAME_OBJECTIVES`). Pure and differentiable; NaN where a steady
     state or trim failed."""
     prepared = {} if prepared is None else prepared
     data = {}
     for spec in specs:
         key = spec.source_key
-        if key not in data:
+        if key[0] == FRAME_SOURCE:
+            if frame is None:
+                raise ParameterError(f"objective {spec.name!r} is a function of the chassis frame: it needs the "
+                                     "frame (a study with frame variables)")
+        elif key not in data:
             data[key] = SOURCES[key[0]].compute(car, **dict(key[1]), **prepared.get(key, {}))
-    return jnp.stack([jnp.asarray(OBJECTIVES[s.name].extract(data[s.source_key], **s.options), jnp.float64)
-                      for s in specs])
+
+    def value(s):
+        if s.source_key[0] == FRAME_SOURCE:
+            return FRAME_OBJECTIVES[s.name][0](frame)
+        return OBJECTIVES[s.name].extract(data[s.source_key], **s.options)
+
+    return jnp.stack([jnp.asarray(value(s), jnp.float64) for s in specs])
+
+
+def objective_units(name: str) -> str:
+    """The units of the objective ``name`` (of the car's or the frame's)."""
+    return FRAME_OBJECTIVES[name][1] if name in FRAME_OBJECTIVES else OBJECTIVES[name].units

@@ -79,13 +79,25 @@ from jaxveh import ParameterError, run_time_checks_off, vehicle
 from jaxveh.params import UNIT_TO_SI, get_at, read_car_file, set_all
 from jaxveh.vehicle import CORNERS
 
+from ._frame_design import (
+    car_with_frame,
+    check_frame_variable,
+    frame_text,
+    is_frame_path,
+    load_car_frame,
+    optimum_frame_text,
+    parse_frame_path,
+    set_frame_sizes,
+)
 from ._objectives import (
     FRAME_OBJECTIVES,
+    FRAME_SOURCE,
     OBJECTIVES,
     REAR_AXLE,
     ObjectiveSpec,
     arb_rates_for_lambda,
     objective_spec,
+    objective_units,
     objective_values,
     prepare,
     roll_rate_coefficients,
@@ -130,7 +142,7 @@ _KEYS = {
     "study": ("name", "description", "model", "vehicle", "modes"),
     "variables": ("path", "name", "units", "lower", "upper", "initial", "log"),
     "term": ("name", "target", "minimise", "maximise", "scale", "weight"),
-    "constraint": ("name", "<=", ">=", "scale"),
+    "constraint": ("name", "<=", ">=", "scale", "reference", "relative"),
     "optimiser": tuple(DEFAULT_OPTIMISER),
     "pareto": ("constraint", "values"),
     "run": ("out",),
@@ -175,15 +187,42 @@ class Term(NamedTuple):
 
 class Bound(NamedTuple):
     """A constraint ``spec <= upper`` (``kind`` "<=") or ``spec >= lower`` (">="), its
-    violation ``(f - bound) / scale`` (or ``(bound - f) / scale``) feasible when <= 0."""
+    violation ``(f - bound) / scale`` (or ``(bound - f) / scale``) feasible when <= 0.
+
+    With ``reference = "rigid"`` the bound is on the difference from the same objective of
+    the rigid car, ``f - f_rigid`` (``relative``: ``(f - f_rigid) / |f_rigid|``, and the
+    scale is relative too); ``rigid_value`` is ``f_rigid``, set when the study's design is
+    built (:func:`build_design`)."""
 
     spec: ObjectiveSpec
     kind: str
     bound: float
     scale: float = 1.0
+    reference: Optional[str] = None
+    relative: bool = False
+    rigid_value: Optional[float] = None
+
+    @property
+    def _unit(self) -> float:
+        if self.reference is None:
+            return 1.0
+        if self.rigid_value is None:
+            raise RuntimeError(f"the bound on {self.spec.name} relative to the rigid car has no rigid value yet: "
+                               "build the study's design first (build_design)")
+        return abs(self.rigid_value) if self.relative else 1.0
+
+    @property
+    def limit(self) -> float:
+        """The bound on the objective itself (its units)."""
+        return self.bound * self._unit + (self.rigid_value if self.reference is not None else 0.0)
+
+    @property
+    def limit_scale(self) -> float:
+        """The violation's scale in the objective's units."""
+        return self.scale * self._unit
 
     def violation(self, f):
-        return ((f - self.bound) if self.kind == "<=" else (self.bound - f)) / self.scale
+        return ((f - self.limit) if self.kind == "<=" else (self.limit - f)) / self.limit_scale
 
     @property
     def sign(self) -> float:
@@ -259,6 +298,8 @@ def _design_variable(where: str, i: int, table, model: str) -> DesignVariable:
     if not lower < initial < upper:
         raise _err(where, f"{key}.initial", f"= {initial!r} is not allowed: strictly between lower = {lower!r} "
                    f"and upper = {upper!r}")
+    if is_frame_path(table.get("path")):
+        return _frame_design_variable(where, key, table, lower, upper, initial, log)
     # the sweep's checks of the path (or label), the name, the units and the label's range
     sweep_table = {k: table[k] for k in ("path", "name", "units") if k in table} | {"values": [lower, upper]}
     var = _variable(where, i, sweep_table, model)
@@ -266,18 +307,42 @@ def _design_variable(where: str, i: int, table, model: str) -> DesignVariable:
                           units=var.units)
 
 
+def _frame_design_variable(where, key, table, lower, upper, initial, log) -> DesignVariable:
+    """A variable of the frame's tube sizes (:mod:`optimise._frame_design`; m)."""
+    path = table["path"].strip()
+    try:
+        parse_frame_path(path)
+    except ParameterError as e:
+        raise _err(where, f"{key}.path", f"= {path!r} {e}") from None
+    if not lower > 0.0:
+        raise _err(where, f"{key}.lower", f"= {lower!r} is not allowed: a tube size (m) > 0")
+    name = table.get("name", "_".join(re.findall(r"[A-Za-z0-9]+", path[len("frame.sections."):])))
+    if not isinstance(name, str) or not re.match(r"^[A-Za-z_][A-Za-z0-9_]*$", name):
+        raise _err(where, f"{key}.name", f"= {name!r} is not allowed: an identifier (letters, digits, _)")
+    units = table.get("units", "m")
+    if units != "m":
+        raise _err(where, f"{key}.units", f"= {units!r} is not allowed: 'm' (tube sizes are in metres)")
+    return DesignVariable(name=name, path=path, lower=lower, upper=upper, initial=initial, log=log, units="m")
+
+
 def _settings(table: dict, reserved) -> dict:
     return {k: v for k, v in table.items() if k not in reserved}
 
 
-def _spec(where: str, key: str, table: dict, reserved) -> ObjectiveSpec:
+def _spec(where: str, key: str, table: dict, reserved, frame: bool = False) -> ObjectiveSpec:
     name = table.get("name")
     if not isinstance(name, str):
         raise _err(where, f"{key}.name", f"= {name!r} is not allowed: one of {', '.join(OBJECTIVES)}")
     if name in FRAME_OBJECTIVES:
-        raise _err(where, f"{key}.name", f"= {name!r} is an objective of the chassis frame (a function of "
-                   "jaxveh.fe.Frame), not of the car's parameters: allowed in a car study "
-                   f"{', '.join(OBJECTIVES)}")
+        if not frame:
+            raise _err(where, f"{key}.name", f"= {name!r} is an objective of the chassis frame (a function of "
+                       "jaxveh.fe.Frame): allowed in a study with frame variables (frame.sections... paths); "
+                       f"the car's objectives are {', '.join(OBJECTIVES)}")
+        extra = sorted(_settings(table, reserved))
+        if extra:
+            raise _err(where, f"{key}.{extra[0]}", f"is not a key of objective {name!r}: allowed "
+                       f"{', '.join(reserved)}")
+        return objective_spec(name, frame=True)
     if name not in OBJECTIVES:
         raise _err(where, f"{key}.name", f"= {name!r} is not a known objective: allowed {', '.join(OBJECTIVES)}")
     settings = _settings(table, reserved)
@@ -307,11 +372,11 @@ def _spec(where: str, key: str, table: dict, reserved) -> ObjectiveSpec:
     return spec
 
 
-def _term(where: str, key: str, table, weighted: bool) -> Term:
+def _term(where: str, key: str, table, weighted: bool, frame: bool = False) -> Term:
     if not isinstance(table, dict):
         raise _err(where, key, "is not a table")
     reserved = _KEYS["term"]
-    spec = _spec(where, key, table, reserved)
+    spec = _spec(where, key, table, reserved, frame)
     senses = [s for s in ("target", "minimise", "maximise") if s in table]
     if len(senses) != 1:
         raise _err(where, key, f"needs exactly one of target = VALUE, minimise = true, maximise = true; got "
@@ -329,7 +394,7 @@ def _term(where: str, key: str, table, weighted: bool) -> Term:
     return Term(spec=spec, sense=sense, target=target, scale=scale, weight=weight)
 
 
-def _constraints(where: str, tables) -> tuple[Bound, ...]:
+def _constraints(where: str, tables, frame: bool = False) -> tuple[Bound, ...]:
     if not isinstance(tables, list):
         raise _err(where, "constraints", "is not an array of tables: write [[constraints]] tables")
     out, bounds = [], {}
@@ -337,16 +402,25 @@ def _constraints(where: str, tables) -> tuple[Bound, ...]:
         key = f"constraints[{i}]"
         if not isinstance(table, dict):
             raise _err(where, key, "is not a table: write [[constraints]] tables")
-        spec = _spec(where, key, table, _KEYS["constraint"])
+        spec = _spec(where, key, table, _KEYS["constraint"], frame)
         kinds = [k for k in ("<=", ">=") if k in table]
         if not kinds:
             raise _err(where, key, 'needs a bound: "<=" = VALUE and/or ">=" = VALUE')
         scale = _number(where, f"{key}.scale", table.get("scale", 1.0), positive=True)
+        reference, relative = table.get("reference"), table.get("relative", False)
+        if reference not in (None, "rigid"):
+            raise _err(where, f"{key}.reference", f"= {reference!r} is not allowed: 'rigid' (bounds on the "
+                       "difference from the rigid car's value)")
+        if reference is not None and spec.source_key[0] == FRAME_SOURCE:
+            raise _err(where, f"{key}.reference", f"is not allowed on {spec.name!r}: the rigid car has no frame")
+        if not isinstance(relative, bool) or (relative and reference is None):
+            raise _err(where, f"{key}.relative", f"= {relative!r} is not allowed: true or false, and true only with "
+                       'reference = "rigid"')
         for kind in kinds:
             bound = _number(where, f'{key}."{kind}"', table[kind])
-            out.append(Bound(spec=spec, kind=kind, bound=bound, scale=scale))
-            bounds.setdefault(spec, []).append((kind, bound, key))
-    for spec, items in bounds.items():  # the bounds on one quantity must leave an interval
+            out.append(Bound(spec=spec, kind=kind, bound=bound, scale=scale, reference=reference, relative=relative))
+            bounds.setdefault((spec, reference, relative), []).append((kind, bound, key))
+    for (spec, _, _), items in bounds.items():  # the bounds on one quantity must leave an interval
         lows = [(b, k) for kind, b, k in items if kind == ">="]
         highs = [(b, k) for kind, b, k in items if kind == "<="]
         if lows and highs:
@@ -396,6 +470,27 @@ def _pareto(where: str, table, constraints) -> Optional[ParetoSweep]:
     return ParetoSweep(constraint=matches[0], values=tuple(float(v) for v in values))
 
 
+#: The shared computations a bound relative to the rigid car may use (a rigid car has them).
+RIGID_SOURCES = ("skid_pad", "load_transfer")
+
+
+def _check_rigid_references(where: str, constraints, variables) -> None:
+    """Bounds relative to the rigid car: on its steady-state objectives, and only with frame
+    variables (the rigid car is then the same at every design: its values are computed once)."""
+    for j, c in enumerate(constraints):
+        if c.reference is None:
+            continue
+        if c.spec.source_key[0] not in RIGID_SOURCES:
+            allowed = [n for n, o in OBJECTIVES.items() if o.source in RIGID_SOURCES]
+            raise _err(where, "constraints", f"bound {j} on {c.spec.name!r} has reference = 'rigid': allowed on "
+                       f"{', '.join(allowed)} (the rigid car has no chassis mode)")
+        moving = [v.path for v in variables if not is_frame_path(v.path)]
+        if moving:
+            raise _err(where, "constraints", f"bound {j} on {c.spec.name!r} has reference = 'rigid' with the "
+                       f"variable {moving[0]!r}, which changes the rigid car too: allowed with frame variables "
+                       "only (frame.sections... paths)")
+
+
 def _check_lambda(where: str, variables) -> None:
     if "lambda" not in [v.path for v in variables]:
         return
@@ -433,13 +528,16 @@ def load_optimisation_study(path, *, out=None) -> OptimisationStudy:
     if ("objective" in data) == ("objectives" in data):
         raise _err(where, "objective", "is needed: one [objective] table or an array of [[objectives]] tables "
                    "(a weighted sum), not both")
+    frame = any(is_frame_path(v.path) for v in variables)
     if "objective" in data:
-        terms = (_term(where, "objective", data["objective"], weighted=False),)
+        terms = (_term(where, "objective", data["objective"], weighted=False, frame=frame),)
     else:
         if not isinstance(data["objectives"], list) or not data["objectives"]:
             raise _err(where, "objectives", "is not a non-empty array of tables: write [[objectives]] tables")
-        terms = tuple(_term(where, f"objectives[{i}]", t, weighted=True) for i, t in enumerate(data["objectives"]))
-    constraints = _constraints(where, data.get("constraints", []))
+        terms = tuple(_term(where, f"objectives[{i}]", t, weighted=True, frame=frame)
+                      for i, t in enumerate(data["objectives"]))
+    constraints = _constraints(where, data.get("constraints", []), frame)
+    _check_rigid_references(where, constraints, variables)
     pareto = _pareto(where, data.get("pareto"), constraints)
     optimiser = _optimiser(where, data.get("optimiser", {}))
     name = study_t.get("name", path.stem)
@@ -486,14 +584,17 @@ def _sweep_study(where, path: Path, study_t: dict, variables) -> Study:
 
 class Design(NamedTuple):
     """A study's car and compiled evaluation: the base ``car``, the ``problem`` (bounded
-    variables on ``(car, coefficients)``), the objective ``specs`` and their ``prepared``
-    arrays, and ``evaluate(z) -> (values, jacobian)`` (NumPy; one compiled program)."""
+    variables on ``(car, coefficients)``, and the base ``frame`` after them in a study with
+    frame variables), the objective ``specs`` and their ``prepared`` arrays,
+    ``evaluate(z) -> (values, jacobian)`` (NumPy; one compiled program) and the rigid car's
+    values ``rigid_values`` ({spec: value}) of the bounds relative to it."""
 
     car: object
     problem: Problem
     specs: tuple
     prepared: dict
     evaluate: Callable
+    rigid_values: dict = {}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -504,14 +605,19 @@ class _DesignApply:
 
     paths: tuple  # (name, path) of the path variables
     lam: Optional[str]  # the name of the lambda variable, if any
+    frame: tuple = ()  # (name, FrameVariable) of the frame variables; base = (car, coefficients, frame)
 
     def __call__(self, base, values):
-        car, coefficients = base
+        car, coefficients = base[:2]
         params = set_all(car.params, {p: values[n] for n, p in self.paths})
         if self.lam is not None:
             rates = arb_rates_for_lambda(coefficients, values[self.lam])
             params = eqx.tree_at(lambda p: p.arb_rates, params, rates)
-        return eqx.tree_at(lambda c: c.params, car, params), coefficients
+        car = eqx.tree_at(lambda c: c.params, car, params)
+        if not self.frame:
+            return car, coefficients
+        frame = set_frame_sizes(base[2], tuple((var, values[n]) for n, var in self.frame))
+        return car_with_frame(car, frame), coefficients, frame
 
 
 @dataclasses.dataclass(frozen=True)
@@ -523,8 +629,13 @@ class _StudyObjective:
     specs: tuple
 
     def __call__(self, base, prepared=None):
-        values = objective_values(base[0], self.specs, prepared)
+        values = objective_values(base[0], self.specs, prepared, frame=_frame_of(base))
         return sum(t.value(values[self.specs.index(t.spec)]) for t in self.terms)
+
+
+def _frame_of(base):
+    """The frame of a design's ``base`` (None without frame variables)."""
+    return base[2] if len(base) > 2 else None
 
 
 def design_car(design: Design, values: dict):
@@ -540,8 +651,8 @@ def _values_and_jacobian(z, base, variables, apply, specs, prepared):
     problem = Problem(params=base, variables=variables, objective=_StudyObjective((), specs), apply=apply)
 
     def values(z):
-        car, _ = problem.build(z)
-        v = objective_values(car, specs, prepared)
+        built = problem.build(z)
+        v = objective_values(built[0], specs, prepared, frame=_frame_of(built))
         return v, v
 
     jac, v = jax.jacfwd(values, has_aux=True)(z)
@@ -559,8 +670,15 @@ def build_design(study: OptimisationStudy) -> Design:
     sweep = _sweep_study(study.file or "study", Path(study.file or "."), {"modes": study.modes}, study.variables)
     sweep = sweep._replace(vehicle=study.vehicle)
     check = lambda params: vehicle.check_car(eqx.tree_at(lambda c: c.params, car, params))  # noqa: E731
+    frame_vars = tuple((v.name, parse_frame_path(v.path)) for v in study.variables if is_frame_path(v.path))
+    frame = _checked_frame(study, car) if frame_vars else None
     for i, v in enumerate(study.variables):
-        if v.path not in LABELS["car"]:
+        if is_frame_path(v.path):
+            try:
+                check_frame_variable(frame, parse_frame_path(v.path), v.lower, v.upper)
+            except ParameterError as e:
+                raise ParameterError(f"{study.where(f'variables[{i}]')} ({v.path!r}) {e}") from None
+        elif v.path not in LABELS["car"]:
             _check_path(sweep, i, car.params, check)
     coefficients = roll_rate_coefficients(car)
     specs = study.specs
@@ -568,9 +686,10 @@ def build_design(study: OptimisationStudy) -> Design:
         prepared = prepare(car, specs)
     except ParameterError as e:
         raise ParameterError(f"{study.where('objective')}: {e}") from None
-    apply = _DesignApply(paths=tuple((v.name, v.path) for v in study.variables if v.path not in LABELS["car"]),
-                         lam=next((v.name for v in study.variables if v.path == "lambda"), None))
-    problem = Problem(params=(car, coefficients),
+    apply = _DesignApply(paths=tuple((v.name, v.path) for v in study.variables
+                                     if v.path not in LABELS["car"] and not is_frame_path(v.path)),
+                         lam=next((v.name for v in study.variables if v.path == "lambda"), None), frame=frame_vars)
+    problem = Problem(params=(car, coefficients) + ((frame,) if frame_vars else ()),
                       variables=tuple(Variable(v.name, v.lower, v.upper, v.log) for v in study.variables),
                       objective=_StudyObjective(study.terms, specs), apply=apply)
     # the mode objectives' forward-mode linearisation is kept out of JAX's disk cache (its
@@ -586,7 +705,41 @@ def build_design(study: OptimisationStudy) -> Design:
             v, jac = _compiled(jnp.asarray(z), problem.params, problem.variables, apply, specs, prepared)
         return np.asarray(v), np.asarray(jac)
 
-    return Design(car=car, problem=problem, specs=specs, prepared=prepared, evaluate=evaluate)
+    return Design(car=car, problem=problem, specs=specs, prepared=prepared, evaluate=evaluate,
+                  rigid_values=rigid_values(study))
+
+
+def _checked_frame(study: OptimisationStudy, car):
+    """The car file's frame, for a study with frame variables (a flexible car's)."""
+    if car.n_modes == 0:
+        raise ParameterError(f"{study.where('study.modes')} = 0: frame variables need a flexible chassis (modes >= 1)")
+    return load_car_frame(study.vehicle)
+
+
+def rigid_values(study: OptimisationStudy) -> dict:
+    """``{spec: value}`` of the study's bounds relative to the rigid car (``reference =
+    "rigid"``): their objectives on the study's car with a rigid chassis (one compiled
+    call); ``ParameterError`` when the rigid car has no steady state there."""
+    specs = tuple(dict.fromkeys(c.spec for c in study.constraints if c.reference == "rigid"))
+    if not specs:
+        return {}
+    rigid = vehicle.load_car(study.vehicle, modes=0)
+    with run_time_checks_off():
+        values = np.asarray(_rigid_values(rigid, specs))
+    if not np.all(np.isfinite(values)):
+        bad = [s.name for s, x in zip(specs, values) if not np.isfinite(x)]
+        raise ParameterError(f"{study.where('constraints')}: the rigid car's {', '.join(bad)} failed (no steady "
+                             "state): no reference for the bounds relative to it")
+    return {s: float(x) for s, x in zip(specs, values)}
+
+
+_rigid_values = eqx.filter_jit(lambda car, specs: objective_values(car, specs))
+
+
+def _with_rigid_values(study: OptimisationStudy, design: Design) -> OptimisationStudy:
+    """``study`` with the rigid car's values set on its bounds relative to it."""
+    return study._replace(constraints=tuple(c._replace(rigid_value=design.rigid_values[c.spec])
+                                            if c.reference else c for c in study.constraints))
 
 
 # ---- the optimisation -------------------------------------------------------------------------
@@ -654,7 +807,7 @@ def _merit(study, index, ev: _Evaluation, multipliers, rho):
         violations[j] = g
         active = max(0.0, multipliers[j] + rho * g)
         merit += (active**2 - multipliers[j] ** 2) / (2.0 * rho)
-        grad = grad + active * c.sign / c.scale * ev.jac[k]
+        grad = grad + active * c.sign / c.limit_scale * ev.jac[k]
     return f, merit, grad, violations
 
 
@@ -668,6 +821,7 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
     else that result with ``failed`` True."""
     start = time.perf_counter()
     design = build_design(study) if design is None else design
+    study = _with_rigid_values(study, design)
     problem, specs = design.problem, design.specs
     index = {s: k for k, s in enumerate(specs)}
     labels = [_label(s, specs) for s in specs]
@@ -699,8 +853,10 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
         optimum = {k: float(x) for k, x in problem.to_values(jnp.asarray(ev.z)).items()}
         f, _, _, violations = _merit(study, index, ev, multipliers, rho) if finite(ev) else (math.nan,) * 3 + (
             np.full(len(study.constraints), math.nan),)
-        cons = [{"name": c.spec.name, "kind": c.kind, "bound": c.bound, "value": float(ev.values[index[c.spec]]),
-                 "violation": float(g)} for c, g in zip(study.constraints, violations)]
+        cons = [{"name": c.spec.name, "kind": c.kind, "bound": c.limit, "value": float(ev.values[index[c.spec]]),
+                 "violation": float(g)} | ({"reference": c.reference, "relative": c.relative,
+                                            "relative_bound": c.bound, "rigid_value": c.rigid_value}
+                                           if c.reference else {}) for c, g in zip(study.constraints, violations)]
         return OptimisationResult(study=study, optimum=optimum, objective=float(f),
                                   values={label: float(x) for label, x in zip(labels, ev.values)}, constraints=cons,
                                   converged=converged, message=message, iterations=len(history),
@@ -805,7 +961,7 @@ def result_report(result: OptimisationResult, files: Optional[dict] = None) -> d
         "failed": result.failed,
         "message": result.message,
         "values": result.values,
-        "units": {_label(s, study.specs): OBJECTIVES[s.name].units for s in study.specs},
+        "units": {_label(s, study.specs): objective_units(s.name) for s in study.specs},
         "constraints": result.constraints,
         "variables": {v.name: {"path": v.path, "lower": v.lower, "upper": v.upper, "initial": v.initial,
                                "log": v.log, "units": v.units} for v in study.variables},
@@ -857,10 +1013,11 @@ def _set_value(text: str, section: str, key: str, value: str) -> str:
     return "".join(lines)
 
 
-def optimum_car_file(result: OptimisationResult) -> str:
+def optimum_car_file(result: OptimisationResult, frame_file=None) -> str:
     """The base car file's text with the optimum's changed values written in (only those,
     in the file's units; :data:`CAR_FILE_KEYS`), its ``[files]`` made absolute where they
-    were paths relative to the base file, and a header naming the study. A car file for
+    were paths relative to the base file (``frame_file``: the optimum's frame file, for a
+    study with frame variables), and a header naming the study. A car file for
     ``--vehicle``."""
     study = result.study
     text = _car_text(study)
@@ -873,7 +1030,10 @@ def optimum_car_file(result: OptimisationResult) -> str:
         for key, name in files.items():
             if Path(name).is_file() and not Path(name).is_absolute():
                 text = _set_value(text, "files", key, json.dumps(str(Path(name).resolve())))
-    unwritten = [v.path for v in study.variables if v.path != "lambda" and v.path not in CAR_FILE_KEYS]
+    if frame_file is not None:
+        text = _set_value(text, "files", "frame", json.dumps(str(Path(frame_file).resolve())))
+    unwritten = [v.path for v in study.variables
+                 if v.path != "lambda" and v.path not in CAR_FILE_KEYS and not is_frame_path(v.path)]
     head = [f"# The optimum of the study {study.name!r} ({study.file or 'built in Python'}), written by jaxveh "
             "optimise:", "# " + ", ".join(f"{k} = {v:.10g}" for k, v in result.optimum.items()) +
             f" (converged: {str(result.converged).lower()})"]
@@ -883,10 +1043,23 @@ def optimum_car_file(result: OptimisationResult) -> str:
     return "\n".join(head) + "\n" + text
 
 
+def frame_sizes(result: OptimisationResult) -> tuple:
+    """``((FrameVariable, value (m)), ...)`` of the optimum's frame variables."""
+    return tuple((parse_frame_path(v.path), result.optimum[v.name]) for v in result.study.variables
+                 if is_frame_path(v.path))
+
+
+def optimum_frame_file(result: OptimisationResult) -> str:
+    """The base car's frame file with the optimum's tube sizes written in (mm)."""
+    vehicle_file = result.study.vehicle
+    return optimum_frame_text(frame_text(vehicle_file), load_car_frame(vehicle_file), frame_sizes(result))
+
+
 def write_outputs(result: OptimisationResult, out_dir=None) -> dict:
     """Write ``OUT/NAME.json`` (:func:`result_report`), ``OUT/NAME_history.csv`` (one row
-    per iteration) and ``OUT/NAME_car.toml`` (:func:`optimum_car_file`; not after a failed
-    run); returns ``{kind: path}``."""
+    per iteration) and ``OUT/NAME_car.toml`` (:func:`optimum_car_file`; with frame
+    variables also ``OUT/NAME_frame.toml``, :func:`optimum_frame_file`, which the car file
+    names; not after a failed run); returns ``{kind: path}``."""
     out = Path(result.study.out if out_dir is None else out_dir)
     out.mkdir(parents=True, exist_ok=True)
     name = result.study.name
@@ -897,8 +1070,11 @@ def write_outputs(result: OptimisationResult, out_dir=None) -> dict:
         writer.writeheader()
         writer.writerows(result.history)
     if not result.failed:
+        if frame_sizes(result):
+            files["frame"] = str(out / f"{name}_frame.toml")
+            Path(files["frame"]).write_text(optimum_frame_file(result))
         files["vehicle"] = str(out / f"{name}_car.toml")
-        Path(files["vehicle"]).write_text(optimum_car_file(result))
+        Path(files["vehicle"]).write_text(optimum_car_file(result, files.get("frame")))
     report = result_report(result, files)
     Path(files["json"]).write_text(json.dumps(report, indent=2))
     return files

@@ -24,7 +24,7 @@ from typing import NamedTuple, Optional
 
 import numpy as np
 
-from ._objectives import OBJECTIVES
+from ._objectives import objective_units
 from ._optimise_study import (
     Design,
     OptimisationStudy,
@@ -98,17 +98,18 @@ def pareto_report(front: ParetoResult) -> dict:
     points = []
     for eps, r in zip(front.bounds, front.results):
         c = r.constraints[j]
-        active = bool(np.isfinite(c["value"]) and abs(c["value"] - eps) <= 1e-6 * bound.scale)
+        unit = abs(c["rigid_value"]) if c.get("relative") else 1.0
+        active = bool(np.isfinite(c["value"]) and abs(c["value"] - c["bound"]) <= 1e-6 * bound.scale * unit)
         points.append({"bound": eps, "optimum": r.optimum, "objective": _finite(r.objective),
                        "values": {k: _finite(v) for k, v in r.values.items()},
                        "constrained_value": _finite(c["value"]), "active": active, "converged": r.converged,
                        "failed": r.failed, "message": r.message, "iterations": r.iterations,
                        "evaluations": r.evaluations})
     return {"study": study.name, "constraint": {"name": bound.spec.name, "kind": bound.kind,
-                                                "units": OBJECTIVES[bound.spec.name].units},
+                                                "units": objective_units(bound.spec.name)},
             "objective_terms": [{"name": t.spec.name, "sense": t.sense, "target": t.target, "scale": t.scale,
                                  "weight": t.weight} for t in study.terms],
-            "units": {_label(s, study.specs): OBJECTIVES[s.name].units for s in study.specs},
+            "units": {_label(s, study.specs): objective_units(s.name) for s in study.specs},
             "points": points, "wall_s": front.wall_s}
 
 

@@ -33,6 +33,7 @@ from ._beam import (
 )
 from ._body import (
     frame_modal_body as frame_modal_body,
+    frame_modal_body_like as frame_modal_body_like,
     nodal_mass_data as nodal_mass_data,
     split_modes as split_modes,
     straight_beam_body as straight_beam_body,

@@ -80,6 +80,40 @@ def _frame_modal_body(frame, n_modes, names, index, origin, zeta, alpha, beta) -
     )
 
 
+def frame_modal_body_like(frame: Frame, like: ModalBody) -> ModalBody:
+    """The modal body of ``frame`` (new tube sizes, say) built as ``like`` was: the same
+    points, mode count, damping and stiffness multipliers µ, and body origin; each mode's
+    sign chosen so that its translations at the points agree with ``like``'s (positive
+    sum of products), so that a modal coordinate keeps its meaning as the frame changes
+    (a mode that changes order with another is not followed: the sign is then arbitrary).
+
+    ``frame`` must have ``like``'s points as named nodes (the same frame topology). Pure
+    and differentiable in ``frame``'s sizes: a design study's chassis (``optimise``)."""
+    if not frame.lumped_mass:
+        raise ParameterError("frame_modal_body_like needs lumped_mass = true (nodal masses and inertias, "
+                             "section 5.4.2)")
+    index = tuple(frame.node_index(n) for n in like.point_names)
+    check_mode_count(like.n_modes, frame_mesh(frame).n_dof - N_RIGID)
+    return _frame_modal_body_like(frame, like, index)
+
+
+@eqx.filter_jit
+def _frame_modal_body_like(frame, like, index) -> ModalBody:
+    K, M = assemble(frame)
+    _, phi = free_free_modes(K, M, like.n_modes)
+    pt, _ = split_modes(phi)
+    agreement = jnp.sum(pt[np.asarray(index)] * like.point_phi_translation, axis=(0, 1))
+    phi = phi * jnp.where(agreement < 0.0, -1.0, 1.0)[None, :]
+    origin = mesh_xyz(frame)[index[0]] - like.point_xyz[0]
+    xyz = mesh_xyz(frame) - origin[None, :]
+    mass, inertia = nodal_mass_data(M)
+    pt, pr = split_modes(phi)
+    ke = phi.T @ K @ phi
+    body = modal_body(xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), like.point_names, index)
+    return eqx.tree_at(lambda b: (b.alpha, b.beta, b.damping_ratio, b.stiffness_scale), body,
+                       (like.alpha, like.beta, like.damping_ratio, like.stiffness_scale))
+
+
 def straight_tube_frame(
     length: float = 1.0,
     n_elements: int = 10,
