@@ -4,8 +4,9 @@ objective, differentiated end to end.
 
 A variable's path ``frame.sections.NAMES.QUANTITY`` sets the outer ``diameter`` or the wall
 ``thickness`` (m) of one or more cross sections of the car's frame (the car file's
-``[files] frame``); ``NAMES`` joins section names with ``+`` for one gauge shared by several
-sections (``frame.sections.rail+hoop.thickness``). Each evaluation assembles the frame,
+``[files] frame``), or multiplies them (``diameter_scale``, ``thickness_scale``: 1 is the
+car file's frame); ``NAMES`` joins section names with ``+`` for one gauge or one factor
+shared by several sections (``frame.sections.rail+hoop.thickness``). Each evaluation assembles the frame,
 solves its free-free eigenproblem and rebuilds the car's chassis from it with
 :func:`jaxveh.fe.frame_modal_body_like`: the same points, mode count, damping and stiffness
 multipliers as the base car's chassis, each mode's sign kept. The car's sprung mass and
@@ -28,8 +29,8 @@ from jaxveh.params import read_car_file
 
 #: Prefix of the frame variables' paths.
 FRAME_PREFIX = "frame.sections."
-#: The section sizes a frame variable can set (m).
-FRAME_QUANTITIES = ("diameter", "thickness")
+#: What a frame variable sets: a size (m) or a multiplier of the base frame's size (1).
+FRAME_QUANTITIES = ("diameter", "thickness", "diameter_scale", "thickness_scale")
 #: The shipped frame's name in a car file's ``[files] frame``.
 SHIPPED_FRAME = "fsae_2009_frame.toml"
 
@@ -39,6 +40,15 @@ class FrameVariable(NamedTuple):
 
     sections: tuple[str, ...]
     quantity: str
+
+    @property
+    def size(self) -> str:
+        """The section attribute set: ``diameter`` or ``thickness``."""
+        return self.quantity.removesuffix("_scale")
+
+    @property
+    def is_scale(self) -> bool:
+        return self.quantity.endswith("_scale")
 
 
 def is_frame_path(path: str) -> bool:
@@ -82,37 +92,59 @@ def frame_text(vehicle) -> str:
     return Path(name).read_text()
 
 
-def check_frame_variable(frame: fe.Frame, var: FrameVariable, lower: float, upper: float) -> None:
-    """The sections exist and carry the quantity, and the bounds are sizes the sections
-    allow (> 0; a wall at most half the smallest diameter); ``ParameterError``."""
-    for name in var.sections:
-        if name not in frame.section_names:
-            raise ParameterError(f"names the section {name!r}, which the frame does not have: allowed "
-                                 f"{', '.join(frame.section_names)}")
-        section = frame.sections[frame.section_names.index(name)]
-        if not hasattr(section, var.quantity):
-            raise ParameterError(f"sets the {var.quantity} of section {name!r}, a {type(section).__name__}, which "
-                                 "has none: allowed thickness (and diameter for circular tubes)")
-    if not lower > 0.0:
-        raise ParameterError(f"has lower = {lower!r}: a size (m) needs lower > 0")
-    if var.quantity == "thickness":
+def check_frame_variables(frame: fe.Frame, variables) -> None:
+    """Each of ``variables`` (``((FrameVariable, lower, upper), ...)``) names sections the
+    frame has, with the size it sets, each section's size set by one variable at most, and
+    bounds the sections allow (> 0; a wall at most half the section's diameter, or of its
+    smaller side); ``ParameterError`` starting with ``variables[i]``. Entries with ``var``
+    None (a study's other variables) are skipped."""
+    seen = {}
+    for i, (var, lower, upper) in enumerate(variables):
+        if var is None:
+            continue
+        where = f"variables[{i}] ({FRAME_PREFIX}{'+'.join(var.sections)}.{var.quantity})"
         for name in var.sections:
+            if name not in frame.section_names:
+                raise ParameterError(f"{where} names the section {name!r}, which the frame does not have: allowed "
+                                     f"{', '.join(frame.section_names)}")
             section = frame.sections[frame.section_names.index(name)]
-            half = 0.5 * float(section.diameter if hasattr(section, "diameter") else min(section.width,
-                                                                                           section.height))
-            if upper > half:
-                raise ParameterError(f"has upper = {upper!r} m, a wall thicker than half of section {name!r} "
-                                     f"({half!r} m): allowed upper <= {half!r}")
+            if not hasattr(section, var.size):
+                raise ParameterError(f"{where} sets the {var.size} of section {name!r}, a {type(section).__name__}, "
+                                     "which has none: allowed thickness (and diameter for circular tubes)")
+            if (name, var.size) in seen:
+                raise ParameterError(f"{where} sets the {var.size} of section {name!r}, which {seen[name, var.size]} "
+                                     "sets: each size by one variable")
+            seen[name, var.size] = where
+        if not lower > 0.0:
+            raise ParameterError(f"{where} has lower = {lower!r}: a size or a factor needs lower > 0")
+        if var.size == "thickness":
+            for name in var.sections:
+                section = frame.sections[frame.section_names.index(name)]
+                half = 0.5 * float(section.diameter if hasattr(section, "diameter")
+                                   else min(section.width, section.height))
+                most = half / float(section.thickness) if var.is_scale else half
+                if upper > most:
+                    raise ParameterError(f"{where} has upper = {upper!r}, a wall thicker than half of section "
+                                         f"{name!r} ({half!r} m): allowed upper <= {most!r}")
 
 
-def set_frame_sizes(frame: fe.Frame, sizes) -> fe.Frame:
-    """``frame`` with the sizes ``((FrameVariable, value (m)), ...)`` set (traceable)."""
-    sections = list(frame.sections)
-    for var, value in sizes:
+def section_sizes(frame: fe.Frame, assignments) -> dict:
+    """``{(section, size): value (m)}`` of the assignments ``((FrameVariable, value),
+    ...)`` on the base ``frame`` (factors multiply its sizes); traceable."""
+    out = {}
+    for var, value in assignments:
         for name in var.sections:
-            k = frame.section_names.index(name)
-            sections[k] = eqx.tree_at(lambda s, q=var.quantity: getattr(s, q), sections[k],
-                                      jnp.asarray(value, jnp.float64))
+            base = getattr(frame.sections[frame.section_names.index(name)], var.size)
+            out[name, var.size] = value * base if var.is_scale else jnp.asarray(value, jnp.float64)
+    return out
+
+
+def set_frame_sizes(frame: fe.Frame, assignments) -> fe.Frame:
+    """``frame`` with the assignments ``((FrameVariable, value), ...)`` made (traceable)."""
+    sections = list(frame.sections)
+    for (name, size), value in section_sizes(frame, assignments).items():
+        k = frame.section_names.index(name)
+        sections[k] = eqx.tree_at(lambda s, q=size: getattr(s, q), sections[k], value)
     return fe.with_sections(frame, sections)
 
 
@@ -134,17 +166,17 @@ def _set_size(text: str, section: str, key: str, value_mm: float) -> str:
     return new
 
 
-def optimum_frame_text(text: str, frame: fe.Frame, variables) -> str:
-    """The frame file ``text`` with the sizes of ``variables`` (``((FrameVariable, value),
-    ...)``, m) written in (mm, the file's unit), checked by reading it back."""
-    for var, value in variables:
-        for name in var.sections:
-            text = _set_size(text, name, var.quantity, round(float(value) * 1e3, 9))
+def optimum_frame_text(text: str, frame: fe.Frame, assignments) -> str:
+    """The frame file ``text`` (of the base ``frame``) with the sizes of ``assignments``
+    (``((FrameVariable, value), ...)``) written in (mm, the file's unit), checked by
+    reading it back."""
+    sizes = {k: float(v) for k, v in section_sizes(frame, assignments).items()}
+    for (name, size), value in sizes.items():
+        text = _set_size(text, name, size, round(value * 1e3, 9))
     written = fe.frame_from_dict(tomllib.loads(text), "optimum frame")
-    for var, value in variables:
-        for name in var.sections:
-            got = float(getattr(written.sections[written.section_names.index(name)], var.quantity))
-            if abs(got - float(value)) > 1e-9:
-                raise ParameterError(f"writing the optimum frame: section {name!r} {var.quantity} reads back as "
-                                     f"{got!r} m, not {float(value)!r} m")
+    for (name, size), value in sizes.items():
+        got = float(getattr(written.sections[written.section_names.index(name)], size))
+        if abs(got - value) > 1e-11:
+            raise ParameterError(f"writing the optimum frame: section {name!r} {size} reads back as {got!r} m, not "
+                                 f"{value!r} m")
     return text

@@ -81,7 +81,7 @@ from jaxveh.vehicle import CORNERS
 
 from ._frame_design import (
     car_with_frame,
-    check_frame_variable,
+    check_frame_variables,
     frame_text,
     is_frame_path,
     load_car_frame,
@@ -315,14 +315,15 @@ def _frame_design_variable(where, key, table, lower, upper, initial, log) -> Des
     except ParameterError as e:
         raise _err(where, f"{key}.path", f"= {path!r} {e}") from None
     if not lower > 0.0:
-        raise _err(where, f"{key}.lower", f"= {lower!r} is not allowed: a tube size (m) > 0")
+        raise _err(where, f"{key}.lower", f"= {lower!r} is not allowed: a tube size (m) or factor > 0")
     name = table.get("name", "_".join(re.findall(r"[A-Za-z0-9]+", path[len("frame.sections."):])))
     if not isinstance(name, str) or not re.match(r"^[A-Za-z_][A-Za-z0-9_]*$", name):
         raise _err(where, f"{key}.name", f"= {name!r} is not allowed: an identifier (letters, digits, _)")
-    units = table.get("units", "m")
-    if units != "m":
-        raise _err(where, f"{key}.units", f"= {units!r} is not allowed: 'm' (tube sizes are in metres)")
-    return DesignVariable(name=name, path=path, lower=lower, upper=upper, initial=initial, log=log, units="m")
+    units = "1" if parse_frame_path(path).is_scale else "m"
+    if table.get("units", units) != units:
+        raise _err(where, f"{key}.units", f"= {table['units']!r} is not allowed: {units!r} (sizes are in metres, "
+                   "factors have no unit)")
+    return DesignVariable(name=name, path=path, lower=lower, upper=upper, initial=initial, log=log, units=units)
 
 
 def _settings(table: dict, reserved) -> dict:
@@ -673,13 +674,14 @@ def build_design(study: OptimisationStudy) -> Design:
     frame_vars = tuple((v.name, parse_frame_path(v.path)) for v in study.variables if is_frame_path(v.path))
     frame = _checked_frame(study, car) if frame_vars else None
     for i, v in enumerate(study.variables):
-        if is_frame_path(v.path):
-            try:
-                check_frame_variable(frame, parse_frame_path(v.path), v.lower, v.upper)
-            except ParameterError as e:
-                raise ParameterError(f"{study.where(f'variables[{i}]')} ({v.path!r}) {e}") from None
-        elif v.path not in LABELS["car"]:
+        if not is_frame_path(v.path) and v.path not in LABELS["car"]:
             _check_path(sweep, i, car.params, check)
+    if frame_vars:
+        try:
+            check_frame_variables(frame, [(parse_frame_path(v.path), v.lower, v.upper) if is_frame_path(v.path)
+                                          else (None, 1.0, 1.0) for v in study.variables])
+        except ParameterError as e:
+            raise ParameterError(f"{study.file or 'study'}: {e}") from None
     coefficients = roll_rate_coefficients(car)
     specs = study.specs
     try:

@@ -206,8 +206,14 @@ def design(study_path):
 
 def test_unknown_section_and_thick_wall_are_refused_on_the_car(tmp_path):
     for old, new, match in (
-        ("rail+side_impact", "rail+roll_cage", r"variables\[0\] \('frame.sections.rail\+roll_cage.thickness'\) "
+        ("rail+side_impact", "rail+roll_cage", r"variables\[0\] \(frame.sections.rail\+roll_cage.thickness\) "
                                                "names the section 'roll_cage'"),
+        ('path = "frame.sections.front_rail.diameter"', 'path = "frame.sections.rail.thickness_scale"',
+         r"variables\[1\] \(frame.sections.rail.thickness_scale\) sets the thickness of section 'rail', which "
+         r"variables\[0\] \(.*\) sets"),
+        ("initial = 0.02", 'initial = 0.02\nunits = "m"\n[[variables]]\npath = "frame.sections.hoop.thickness_scale"\n'
+         "lower = 0.5\nupper = 30.0",
+         r"variables\[2\] .* has upper = 30.0, a wall thicker than half of section 'hoop'"),
         ("upper = 0.003", "upper = 0.02", "a wall thicker than half of section 'rail'"),
     ):
         path = _write(tmp_path, _variant(old, new).format(modes=MODES))
