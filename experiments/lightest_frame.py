@@ -107,7 +107,7 @@ def main():
     names = [v.name for v in study.variables]
     result = optimise.optimise_study(study, design=design, throw=False, progress=lambda e: print(
         f"  {e['iteration']:3d} outer {e['outer']}  mass {e['chassis_mass']:.3f} kg  merit {e['merit']:.4e}  "
-        f"|grad| {e['grad_norm']:.2e}  " + "  ".join(f"{n} {e[n]:.4f}" for n in names), flush=True))
+        f"|grad| {e['grad_norm']:.2e}  " + "  ".join(f"{n} {e[n]:.4f}" for n in names + labels[1:]), flush=True))
     files = optimise.write_outputs(result)
     shipped = _frame_summary(optimise.load_car_frame(study.vehicle))
     optimum = _frame_summary(fe.load_frame(files["frame"])) if "frame" in files else None

@@ -82,10 +82,13 @@ def _frame_modal_body(frame, n_modes, names, index, origin, zeta, alpha, beta) -
 
 def frame_modal_body_like(frame: Frame, like: ModalBody) -> ModalBody:
     """The modal body of ``frame`` (new tube sizes, say) built as ``like`` was: the same
-    points, mode count, damping and stiffness multipliers µ, and body origin; each mode's
-    sign chosen so that its translations at the points agree with ``like``'s (positive
-    sum of products), so that a modal coordinate keeps its meaning as the frame changes
-    (a mode that changes order with another is not followed: the sign is then arbitrary).
+    points, mode count, damping and stiffness multipliers µ, and body origin, with each
+    modal coordinate kept on the same physical mode as the frame changes. The lowest
+    ``like.n_modes`` elastic modes of ``frame`` are put in the order of ``like``'s modes
+    they resemble most (greedily, ``like``'s first mode first, by the MAC of their
+    translations at the points), so that two modes that cross in frequency keep their
+    coordinates (and their multipliers µ), and each mode's sign is chosen so that its
+    translations at the points agree with its ``like`` mode's (positive sum of products).
 
     ``frame`` must have ``like``'s points as named nodes (the same frame topology). Pure
     and differentiable in ``frame``'s sizes: a design study's chassis (``optimise``)."""
@@ -102,8 +105,11 @@ def _frame_modal_body_like(frame, like, index) -> ModalBody:
     K, M = assemble(frame)
     _, phi = free_free_modes(K, M, like.n_modes)
     pt, _ = split_modes(phi)
-    agreement = jnp.sum(pt[np.asarray(index)] * like.point_phi_translation, axis=(0, 1))
-    phi = phi * jnp.where(agreement < 0.0, -1.0, 1.0)[None, :]
+    new, old = pt[np.asarray(index)].reshape(-1, like.n_modes), like.point_phi_translation.reshape(-1, like.n_modes)
+    products = old.T @ new  # (like's mode, frame's mode)
+    mac = products**2 / (jnp.sum(old**2, axis=0)[:, None] * jnp.sum(new**2, axis=0)[None, :])
+    order = _greedy_assignment(mac)
+    phi = phi[:, order] * jnp.where(products[jnp.arange(like.n_modes), order] < 0.0, -1.0, 1.0)[None, :]
     origin = mesh_xyz(frame)[index[0]] - like.point_xyz[0]
     xyz = mesh_xyz(frame) - origin[None, :]
     mass, inertia = nodal_mass_data(M)
@@ -112,6 +118,18 @@ def _frame_modal_body_like(frame, like, index) -> ModalBody:
     body = modal_body(xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), like.point_names, index)
     return eqx.tree_at(lambda b: (b.alpha, b.beta, b.damping_ratio, b.stiffness_scale), body,
                        (like.alpha, like.beta, like.damping_ratio, like.stiffness_scale))
+
+
+def _greedy_assignment(score):
+    """For each row in turn, the column of highest ``score`` not taken by an earlier row."""
+    n = score.shape[0]
+    order = []
+    taken = jnp.zeros(score.shape[1], bool)
+    for row in range(n):
+        k = jnp.argmax(jnp.where(taken, -jnp.inf, score[row]))
+        order.append(k)
+        taken = taken.at[k].set(True)
+    return jnp.stack(order)
 
 
 def straight_tube_frame(
