@@ -56,6 +56,7 @@ MODULE_SECONDS = {
     "test_vehicle_rigs.py": 534,
     "test_manoeuvre_steady.py": 477,
     "test_vehicle_fast.py": 472,
+    "test_optimise_frame.py": 500,
     "test_manoeuvre_driver.py": 364,
     "test_multibody_engine.py": 346,
     "test_optimise_sweep.py": 312,
