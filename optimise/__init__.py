@@ -23,6 +23,7 @@ from ._objectives import (
     first_mode_damping_ratio as first_mode_damping_ratio,
     first_mode_frequency as first_mode_frequency,
     first_mode_reference as first_mode_reference,
+    follow_mode as follow_mode,
     matched_eigenvalue as matched_eigenvalue,
     objective_spec as objective_spec,
     objective_units as objective_units,

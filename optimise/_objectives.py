@@ -282,6 +282,19 @@ def first_mode_reference(car, speed_kmh=DEFAULT_SPEED_KMH) -> np.ndarray:
     return vec[:, int(np.argmin(np.abs(lam - target)))]
 
 
+def follow_mode(reference, a) -> np.ndarray:
+    """The eigenvector of ``a`` (a state matrix, NumPy) with a positive imaginary part that
+    has the largest MAC with ``reference``: the reference of the same mode one step further
+    along a design path (mode tracking). A fixed reference loses a mode whose shape changes
+    along the path: near an avoided crossing two eigenvectors resemble it alike and the
+    selection jumps from one to the other (seen in study (d): the first coupled chassis
+    mode at 28.1 Hz and a 22.6 Hz mode both at MAC 0.640 with the shipped car's)."""
+    lam, vec = np.linalg.eig(np.asarray(a))
+    reference = np.asarray(reference)
+    mac = np.abs(np.conj(reference) @ vec) ** 2 / (np.sum(np.abs(reference) ** 2) * np.sum(np.abs(vec) ** 2, axis=0))
+    return vec[:, int(np.argmax(np.where(lam.imag >= 2.0 * np.pi * MIN_MODE_HZ, mac, -1.0)))]
+
+
 def _mode(car, reference, speed_kmh):
     a, ok = state_matrix(car, speed_kmh)
     re, im = matched_eigenvalue(a, jnp.asarray(reference))

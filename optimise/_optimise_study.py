@@ -96,11 +96,13 @@ from ._objectives import (
     REAR_AXLE,
     ObjectiveSpec,
     arb_rates_for_lambda,
+    follow_mode,
     objective_spec,
     objective_units,
     objective_values,
     prepare,
     roll_rate_coefficients,
+    state_matrix,
 )
 from ._problem import Problem, Variable
 from ._study import (
@@ -587,8 +589,11 @@ class Design(NamedTuple):
     """A study's car and compiled evaluation: the base ``car``, the ``problem`` (bounded
     variables on ``(car, coefficients)``, and the base ``frame`` after them in a study with
     frame variables), the objective ``specs`` and their ``prepared`` arrays,
-    ``evaluate(z) -> (values, jacobian)`` (NumPy; one compiled program) and the rigid car's
-    values ``rigid_values`` ({spec: value}) of the bounds relative to it."""
+    ``evaluate(z) -> (values, jacobian)`` (NumPy; one compiled program), the rigid car's
+    values ``rigid_values`` ({spec: value}) of the bounds relative to it, and ``track(z)``
+    (None without mode objectives): moves the mode objectives' reference eigenvectors in
+    ``prepared`` to the design ``z`` (:func:`optimise.follow_mode`), which later
+    evaluations use."""
 
     car: object
     problem: Problem
@@ -596,6 +601,7 @@ class Design(NamedTuple):
     prepared: dict
     evaluate: Callable
     rigid_values: dict = {}
+    track: Optional[Callable] = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -708,7 +714,27 @@ def build_design(study: OptimisationStudy) -> Design:
         return np.asarray(v), np.asarray(jac)
 
     return Design(car=car, problem=problem, specs=specs, prepared=prepared, evaluate=evaluate,
-                  rigid_values=rigid_values(study))
+                  rigid_values=rigid_values(study), track=_mode_tracker(problem, prepared))
+
+
+_state_matrix = eqx.filter_jit(state_matrix)
+
+
+def _mode_tracker(problem: Problem, prepared: dict) -> Optional[Callable]:
+    """``track(z)`` of :class:`Design` for the mode objectives' references in ``prepared``
+    (updated in place), or None when there are none."""
+    keys = [k for k in prepared if k[0] == "linear"]
+    if not keys:
+        return None
+
+    def track(z):
+        car = problem.build(jnp.asarray(z))[0]
+        for key in keys:
+            a, ok = _state_matrix(car, dict(key[1])["speed_kmh"])
+            if bool(ok):
+                prepared[key] = {**prepared[key], "reference": follow_mode(prepared[key]["reference"], a)}
+
+    return track
 
 
 def _checked_frame(study: OptimisationStudy, car):
@@ -876,6 +902,12 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
             raise OptimisationError(message, res)
         return res
 
+    def accept(ev: _Evaluation) -> _Evaluation:
+        """Take ``ev`` as the current design: the mode objectives follow their modes to it."""
+        if design.track is not None:
+            design.track(ev.z)
+        return ev
+
     ev = evaluate(problem.to_z({v.name: v.initial for v in study.variables}))
     if not finite(ev):
         return failure(ev, None, "at the initial design")
@@ -901,7 +933,7 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
                 trial = evaluate(ev.z + step)
                 if not finite(trial):
                     return failure(trial, ev, f"at iteration {len(history)}")
-                ev = trial
+                ev = accept(trial)
             else:
                 direction = -step
                 slope = float(grad @ direction)
@@ -928,7 +960,7 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
                     message = "the line search found no decrease (round-off level reached)"
                     inner_converged = np.linalg.norm(grad) <= 1e3 * opts["tolerance"]
                     break
-                ev = accepted
+                ev = accept(accepted)
             f, merit, grad, violations = _merit(study, index, ev, multipliers, rho)
             record(ev, outer, f, merit, grad, violations)
         worst = float(np.max(violations, initial=0.0))

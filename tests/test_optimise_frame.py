@@ -302,3 +302,38 @@ def test_cli_json(design, study_path, tmp_path):
     report = json.loads(done.output)
     assert set(report["optimum"]) == {"t_main", "front_rail_diameter"} and isinstance(report["converged"], bool)
     assert report["files"]["frame"].endswith("lightest_frame.toml")
+
+
+# ---- following a mode along a design path --------------------------------------------------
+
+
+def _two_mode_state_matrix(p):
+    """Two coupled oscillators (unit masses) whose stiffnesses cross at p = 0: k1 = 100 (1 + p),
+    k2 = 100, coupling 5 (an avoided crossing), light damping."""
+    k = np.array([[100.0 * (1.0 + p) + 5.0, -5.0], [-5.0, 100.0 + 5.0]])
+    d = 0.01 * np.eye(2)
+    return np.block([[np.zeros((2, 2)), np.eye(2)], [-k, -d]])
+
+
+def test_a_followed_mode_keeps_its_branch_where_a_fixed_reference_jumps():
+    """Through an avoided crossing, the mode followed in small steps stays on its frequency
+    branch (the lower one) while its shape turns into the other oscillator's; the fixed
+    reference picks, at the end, the eigenvector that resembles the start's shape: the other
+    branch."""
+    path = np.linspace(-0.5, 0.5, 41)
+    lam, vec = np.linalg.eig(_two_mode_state_matrix(path[0]))
+    lower = np.argmin(np.where(lam.imag > 0, lam.imag, np.inf))
+    start = vec[:, lower]
+    followed = start
+    for p in path[1:]:
+        followed = optimise.follow_mode(followed, _two_mode_state_matrix(p))
+    lam_end, vec_end = np.linalg.eig(_two_mode_state_matrix(path[-1]))
+    branches = np.sort(lam_end.imag[lam_end.imag > 0])
+
+    def frequency(v):
+        k = np.argmax(np.abs(np.conj(v) @ vec_end))
+        return lam_end[k].imag
+
+    assert frequency(followed) == pytest.approx(branches[0], rel=1e-9)
+    assert frequency(optimise.follow_mode(start, _two_mode_state_matrix(path[-1]))) == pytest.approx(branches[1],
+                                                                                                      rel=1e-9)
