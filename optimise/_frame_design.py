@@ -157,7 +157,7 @@ def car_with_frame(car, frame: fe.Frame):
 
 
 def _set_size(text: str, section: str, key: str, value_mm: float) -> str:
-    pattern = re.compile(rf"(^\s*\[sections\.{re.escape(section)}\][^\[]*?^\s*{key}\s*=\s*)([^#\n]+?)(\s*(#.*)?)$",
+    pattern = re.compile(rf"(^\s*\[sections\.{re.escape(section)}\][^\[]*?^\s*{key}\s*=\s*)([^#\n]+?)(\s*(#[^\n]*)?)$",
                          re.MULTILINE | re.DOTALL)
     new, count = pattern.subn(lambda m: f"{m.group(1)}{value_mm!r}{m.group(3)}", text, count=1)
     if count != 1:
