@@ -133,7 +133,13 @@ def section_sizes(frame: fe.Frame, assignments) -> dict:
     ...)`` on the base ``frame`` (factors multiply its sizes); traceable."""
     out = {}
     for var, value in assignments:
+        if var.quantity not in FRAME_QUANTITIES:
+            raise ParameterError(f"FrameVariable.quantity = {var.quantity!r} is not allowed: one of "
+                                 f"{', '.join(FRAME_QUANTITIES)}")
         for name in var.sections:
+            if name not in frame.section_names:
+                raise ParameterError(f"FrameVariable.sections names {name!r}, which the frame does not have: "
+                                     f"allowed {', '.join(frame.section_names)}")
             base = getattr(frame.sections[frame.section_names.index(name)], var.size)
             out[name, var.size] = value * base if var.is_scale else jnp.asarray(value, jnp.float64)
     return out

@@ -150,6 +150,13 @@ def test_bad_frame_paths_are_refused(path, match):
         optimise.parse_frame_path(path)
 
 
+def test_bad_frame_variables_are_refused_through_the_python_api(frame):
+    for var, match in ((optimise.FrameVariable(("roll_cage",), "thickness"), "names 'roll_cage'"),
+                       (optimise.FrameVariable(("rail",), "wall"), "quantity = 'wall' is not allowed")):
+        with pytest.raises(ParameterError, match=match):
+            optimise.set_frame_sizes(frame, ((var, 0.001),))
+
+
 def _variant(old, new):
     assert old in STUDY
     return STUDY.replace(old, new, 1)
