@@ -6,10 +6,10 @@ A variable's path ``frame.sections.NAMES.QUANTITY`` sets the outer ``diameter`` 
 ``thickness`` (m) of one or more cross sections of the car's frame (the car file's
 ``[files] frame``), or multiplies them (``diameter_scale``, ``thickness_scale``: 1 is the
 car file's frame); ``NAMES`` joins section names with ``+`` for one gauge or one factor
-shared by several sections (``frame.sections.rail+hoop.thickness``). Each evaluation assembles the frame,
-solves its free-free eigenproblem and rebuilds the car's chassis from it with
-:func:`jaxveh.fe.frame_modal_body_like`: the same points, mode count, damping and stiffness
-multipliers as the base car's chassis, each mode's sign kept. The car's sprung mass and
+shared by several sections (``frame.sections.rail+hoop.thickness``). Each evaluation
+assembles the frame, solves its free-free eigenproblem and rebuilds the car's chassis from
+it with :func:`jaxveh.fe.frame_modal_body_like`: the same points, mode count, damping and
+stiffness multipliers as the base car's chassis, each mode kept on its coordinate and sign. The car's sprung mass and
 inertia stay the car file's (Table B.1 gives them for the whole car): the frame's own mass
 is the objective ``chassis_mass``.
 """

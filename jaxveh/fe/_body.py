@@ -71,13 +71,16 @@ def frame_modal_body(
 def _frame_modal_body(frame, n_modes, names, index, origin, zeta, alpha, beta) -> ModalBody:
     K, M = assemble(frame)
     _, phi = free_free_modes(K, M, n_modes)
+    return _body_of_modes(frame, K, M, phi, origin, names, index, damping_ratio=zeta, alpha=alpha, beta=beta)
+
+
+def _body_of_modes(frame, K, M, phi, origin, names, index, **damping) -> ModalBody:
+    """The :class:`ModalBody` of ``frame``'s mode shapes ``phi`` (columns, global DOF)."""
     xyz = mesh_xyz(frame) - origin[None, :]
     mass, inertia = nodal_mass_data(M)
     pt, pr = split_modes(phi)
     ke = phi.T @ K @ phi
-    return modal_body(
-        xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), names, index, damping_ratio=zeta, alpha=alpha, beta=beta
-    )
+    return modal_body(xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), names, index, **damping)
 
 
 def frame_modal_body_like(frame: Frame, like: ModalBody) -> ModalBody:
@@ -111,11 +114,7 @@ def _frame_modal_body_like(frame, like, index) -> ModalBody:
     order = _greedy_assignment(mac)
     phi = phi[:, order] * jnp.where(products[jnp.arange(like.n_modes), order] < 0.0, -1.0, 1.0)[None, :]
     origin = mesh_xyz(frame)[index[0]] - like.point_xyz[0]
-    xyz = mesh_xyz(frame) - origin[None, :]
-    mass, inertia = nodal_mass_data(M)
-    pt, pr = split_modes(phi)
-    ke = phi.T @ K @ phi
-    body = modal_body(xyz, mass, inertia, pt, pr, 0.5 * (ke + ke.T), like.point_names, index)
+    body = _body_of_modes(frame, K, M, phi, origin, like.point_names, index)
     return eqx.tree_at(lambda b: (b.alpha, b.beta, b.damping_ratio, b.stiffness_scale), body,
                        (like.alpha, like.beta, like.damping_ratio, like.stiffness_scale))
 
