@@ -50,10 +50,35 @@ from jaxveh.analysis import (
 from jaxveh.manoeuvre import skid_pad_core, straight_trim
 from jaxveh.vehicle import CORNERS, car_rates, installation_ratios
 
+from ._response import (
+    linear_io,
+    preview_distance_of,
+    step_metrics_of,
+    sweep_rms_of,
+    yaw_rate_bandwidth_of,
+    yaw_rate_gain_peak_of,
+)
+
 #: Lateral acceleration (g) of the skid-pad objectives by default: the linear range.
 DEFAULT_AY_G = 0.05
 #: Speed (km/h) of the linearisation of the mode objectives by default (the root loci's).
 DEFAULT_SPEED_KMH = 50.0
+#: Speed (km/h) of the step-steer and steering frequency-response objectives by default (Fig. 7.6's).
+STEP_SPEED_KMH = 90.0
+#: Speed (km/h) of the four-post objective by default (:func:`jaxveh.manoeuvre.four_post`'s).
+FOUR_POST_SPEED_KMH = 50.0
+#: Speed (km/h) and points of the preview objective by default (section 7.5's).
+PREVIEW_SPEED_KMH = 100.0
+N_PREVIEW = 250
+#: Options (name -> default) of the step-steer objectives: the cubic's rise, the run's
+#: length and the window of the steady value (s).
+STEP_OPTIONS = {"rise_s": 0.2, "duration_s": 5.0, "settle_s": 0.5}
+#: Options of the steering frequency-response objectives (Hz): the reference (steady) gain's
+#: frequency and the top of the band searched.
+BAND_OPTIONS = {"f_ref_hz": 0.05, "f_max_hz": 20.0}
+#: Options of the four-post objective: the tyre, the post pattern, the post amplitude (m)
+#: and the sweep's band (Hz) (Fig. 7.9's rig, :func:`jaxveh.manoeuvre.four_post`).
+SWEEP_OPTIONS = {"corner": "front_left", "pattern": "warp", "amplitude_m": 0.002, "f0_hz": 0.5, "f1_hz": 30.0}
 #: Damped frequencies below this (Hz) are not vibration modes (the neutral and real modes).
 MIN_MODE_HZ = 1e-3
 
@@ -315,6 +340,92 @@ def first_mode_damping_ratio(car, reference, speed_kmh=DEFAULT_SPEED_KMH):
     return -re / jnp.hypot(re, im)
 
 
+# ---- responses of the linearised car (optimise._response) -----------------------------------
+
+
+def steering_response(car, speed_kmh=STEP_SPEED_KMH):
+    """The car linearised about straight running at ``speed_kmh`` (km/h) with the yaw rate
+    as its output (:class:`optimise._response.LinearIO`; pure)."""
+    return linear_io(car, speed_kmh, ("yaw_rate",))
+
+
+def road_response(car, speed_kmh=FOUR_POST_SPEED_KMH):
+    """The car linearised about straight running at ``speed_kmh`` (km/h) with the four
+    contact-patch loads as its outputs (pure)."""
+    return linear_io(car, speed_kmh, ("fz",))
+
+
+def _response_time(io, **step):
+    return step_metrics_of(io, **{**STEP_OPTIONS, **step}).response_time
+
+
+def _peak_time(io, **step):
+    return step_metrics_of(io, **{**STEP_OPTIONS, **step}).peak_time
+
+
+def _overshoot(io, **step):
+    return step_metrics_of(io, **{**STEP_OPTIONS, **step}).overshoot
+
+
+def _bandwidth(io, **band):
+    return yaw_rate_bandwidth_of(io, **{**BAND_OPTIONS, **band})
+
+
+def _gain_peak(io, **band):
+    return yaw_rate_gain_peak_of(io, **{**BAND_OPTIONS, **band})
+
+
+def _rms_fz(io, **sweep):
+    return sweep_rms_of(io, **{**SWEEP_OPTIONS, **sweep})
+
+
+def yaw_rate_response_time(car, speed_kmh=STEP_SPEED_KMH, **step):
+    """Yaw-rate response time (s) of a small step steer at ``speed_kmh`` (km/h): from 50 % of
+    the steering input to 90 % of the steady yaw rate (ISO 7401), on the linearised car
+    (:func:`optimise._response.step_metrics_of`; ``step``: ``rise_s``, ``duration_s``,
+    ``settle_s``)."""
+    return _response_time(steering_response(car, speed_kmh), **step)
+
+
+def yaw_rate_peak_time(car, speed_kmh=STEP_SPEED_KMH, **step):
+    """Yaw-rate peak time (s) of a small step steer, from 50 % of the input (see
+    :func:`yaw_rate_response_time`); NaN without a peak before the settling window."""
+    return _peak_time(steering_response(car, speed_kmh), **step)
+
+
+def yaw_rate_overshoot(car, speed_kmh=STEP_SPEED_KMH, **step):
+    """Yaw-rate overshoot (% of the steady yaw rate) of a small step steer (see
+    :func:`yaw_rate_response_time`)."""
+    return _overshoot(steering_response(car, speed_kmh), **step)
+
+
+def yaw_rate_bandwidth(car, speed_kmh=STEP_SPEED_KMH, **band):
+    """Yaw-rate bandwidth (Hz) of the linearised car at ``speed_kmh`` (km/h): the first
+    frequency where the gain per steering-wheel angle falls to -3 dB of its value at
+    ``f_ref_hz`` (``band``: ``f_ref_hz``, ``f_max_hz``)."""
+    return _bandwidth(steering_response(car, speed_kmh), **band)
+
+
+def yaw_rate_gain_peak(car, speed_kmh=STEP_SPEED_KMH, **band):
+    """The yaw-rate gain's peak over its value at ``f_ref_hz`` (1) up to ``f_max_hz`` (see
+    :func:`yaw_rate_bandwidth`)."""
+    return _gain_peak(steering_response(car, speed_kmh), **band)
+
+
+def rms_fz_variation(car, speed_kmh=FOUR_POST_SPEED_KMH, **sweep):
+    """RMS contact-patch load variation (N) of one tyre on the four-post rig at
+    ``speed_kmh`` (km/h), a sine sweep of the posts (``sweep``: ``corner``, ``pattern``,
+    ``amplitude_m``, ``f0_hz``, ``f1_hz``), quasi-stationary on the linearised car
+    (:func:`optimise._response.sweep_rms_of`)."""
+    return _rms_fz(road_response(car, speed_kmh), **sweep)
+
+
+def preview_length(car, speed_kmh=PREVIEW_SPEED_KMH, n_preview=N_PREVIEW):
+    """Preview distance Lp (m) of the TI-optimal preview driver on the linearised car at
+    ``speed_kmh`` (km/h) with ``n_preview`` points (section 7.5; eq. 3.46's 98 %)."""
+    return preview_distance_of(car, speed_kmh, n_preview)
+
+
 # ---- the frame --------------------------------------------------------------------------------
 
 
@@ -347,6 +458,9 @@ def _prepare_reference(car, settings):
 
 
 SOURCES = {
+    "steering_response": Source(steering_response, {"speed_kmh": STEP_SPEED_KMH}),
+    "road_response": Source(road_response, {"speed_kmh": FOUR_POST_SPEED_KMH}),
+    "preview": Source(preview_length, {"speed_kmh": PREVIEW_SPEED_KMH, "n_preview": N_PREVIEW}),
     "skid_pad": Source(skid_pad_point, {"ay_g": DEFAULT_AY_G, "radius": SKID_PAD_RADIUS}),
     "load_transfer": Source(load_transfer_point, {"ay_g": tuple(LOW_AY_PAIR_G), "radius": SKID_PAD_RADIUS}),
     "linear": Source(lambda car, speed_kmh, reference: _mode(car, reference, speed_kmh),
@@ -399,6 +513,23 @@ OBJECTIVES = {
                                       "mode about straight running at speed_kmh", "linear", _frequency),
     "first_mode_damping_ratio": Objective(first_mode_damping_ratio, "1", "damping ratio of the first coupled "
                                           "chassis mode about straight running at speed_kmh", "linear", _damping),
+    "yaw_rate_response_time": Objective(yaw_rate_response_time, "s", "yaw-rate response time of a small step "
+                                        "steer (50 % input to 90 % steady, ISO 7401), linearised car",
+                                        "steering_response", _response_time, STEP_OPTIONS),
+    "yaw_rate_peak_time": Objective(yaw_rate_peak_time, "s", "yaw-rate peak time of a small step steer (from 50 % "
+                                    "input), linearised car", "steering_response", _peak_time, STEP_OPTIONS),
+    "yaw_rate_overshoot": Objective(yaw_rate_overshoot, "%", "yaw-rate overshoot of a small step steer, linearised "
+                                    "car", "steering_response", _overshoot, STEP_OPTIONS),
+    "yaw_rate_bandwidth": Objective(yaw_rate_bandwidth, "Hz", "first frequency where the yaw-rate gain per "
+                                    "steering-wheel angle falls to -3 dB of its value at f_ref_hz",
+                                    "steering_response", _bandwidth, BAND_OPTIONS),
+    "yaw_rate_gain_peak": Objective(yaw_rate_gain_peak, "1", "largest yaw-rate gain up to f_max_hz over the gain "
+                                    "at f_ref_hz", "steering_response", _gain_peak, BAND_OPTIONS),
+    "rms_fz_variation": Objective(rms_fz_variation, "N", "RMS contact-patch load variation of one tyre over a "
+                                  "four-post sine sweep (quasi-stationary, linearised car)", "road_response",
+                                  _rms_fz, SWEEP_OPTIONS),
+    "preview_length": Objective(preview_length, "m", "preview distance of the TI-optimal preview driver "
+                                "(section 7.5)", "preview", lambda lp: lp),
 }
 
 #: The shared computation the frame's objectives name (:attr:`ObjectiveSpec.source_key`).

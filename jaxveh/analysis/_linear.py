@@ -140,7 +140,7 @@ def _jacobians(car, trim, speed, channels):
     return a, b, c, d, x0, x_dot0
 
 
-def _linearise(car, speed, channels):
+def linearise_core(car, speed, channels):
     """The pure core of :func:`linearise` (jit, vmap, grad): ``(a, b, c, d, x0, x_dot0, ok)``."""
     trim = straight_trim(car, speed, "fast")
     return _jacobians(car, trim, speed, channels) + (trim.ok,)
@@ -153,7 +153,7 @@ def linearise(car, speed: float = 50.0 / 3.6, outputs=DEFAULT_OUTPUTS) -> CarLin
     """The fast car ``car`` linearised about straight running at ``speed`` (m/s), with the
     channels ``outputs`` (:data:`DEFAULT_OUTPUTS`). Compiled once per car structure and
     output list (``speed`` and every leaf of the car are traced); the pure core is
-    ``_linearise`` (jit, vmap, grad)."""
+    :func:`linearise_core` (jit, vmap, grad)."""
     channels = _check_outputs(outputs)
     if not 0.0 < float(speed) <= 100.0:
         raise ParameterError(f"speed = {speed!r} is out of range: allowed (0, 100] m/s")
@@ -229,7 +229,7 @@ def _mode_order(lam, min_hz: float = 1e-3) -> np.ndarray:
 def _lateral_matrices(params, car, speed):
     """``(a, b, c)`` of the car with ``params``, the output the c.g.'s lateral position."""
     car = eqx.tree_at(lambda c: c.params, car, params)
-    return _linearise(car, speed, ("y",))[:3]
+    return linearise_core(car, speed, ("y",))[:3]
 
 
 #: ``((a, b, c), (da, db, dc))`` along a direction in the car's parameters (one program per

@@ -76,6 +76,10 @@ def _lp(a, b, c, speed, n_q: int, n_preview: int):
     return gains.preview, lp, gains.spectral_radius, gains.result
 
 
+#: The pure core of :func:`car_preview` (jit, vmap, grad): ``(Kp, Lp, spectral radius,
+#: result)`` of the linearisation's ``(a, b, c)`` with the lateral position as the only
+#: output row, at ``speed`` (m/s), ``n_q`` position coordinates and ``n_preview`` points.
+preview_core = _lp
 _compiled_lp = eqx.filter_jit(_lp)
 
 
