@@ -73,6 +73,7 @@ MODULE_SECONDS = {
     "test_plots_layout.py": 99,
     "test_multibody_simplifications.py": 81,
     "test_tyre_magic_formula.py": 70,
+    "test_optimise_response.py": 76,
     "test_analytic_linear.py": 63,
     "test_vehicle_suspension.py": 60,
 }
