@@ -109,10 +109,6 @@ def transfer(io: LinearIO, row: int, weights, frequency_hz):
     return jax.vmap(at)(f.ravel()).reshape(f.shape)
 
 
-def _steering(io: LinearIO):
-    return jnp.zeros(len(INPUTS)).at[STEERING].set(1.0)
-
-
 def _newton(residual, x0, lo, hi):
     """Root of ``residual`` from ``x0`` kept in ``[lo, hi]``: :data:`NEWTON_STEPS` steps
     without derivatives, then one whose derivative is the implicit function theorem's."""
@@ -131,10 +127,10 @@ def _check_band(f_ref_hz, f_max_hz):
 
 
 def _gain_ratio(io: LinearIO, f_ref_hz):
-    """``(ratio(log f), g0)``: the yaw-rate gain over its value ``g0`` at ``f_ref_hz``."""
-    w = _steering(io)
+    """``ratio(log f)``: the yaw-rate gain over its value at ``f_ref_hz``."""
+    w = np.eye(len(INPUTS))[STEERING]
     g0 = jnp.abs(transfer(io, 0, w, f_ref_hz))
-    return (lambda u: jnp.abs(transfer(io, 0, w, jnp.exp(u))) / g0), g0
+    return lambda u: jnp.abs(transfer(io, 0, w, jnp.exp(u))) / g0
 
 
 def yaw_rate_bandwidth_of(io: LinearIO, f_ref_hz, f_max_hz):
@@ -142,7 +138,7 @@ def yaw_rate_bandwidth_of(io: LinearIO, f_ref_hz, f_max_hz):
     at ``f_ref_hz`` (``io``'s first output row the yaw rate); NaN when it stays above up to
     ``f_max_hz`` or without the trim."""
     _check_band(f_ref_hz, f_max_hz)
-    ratio, _ = _gain_ratio(io, f_ref_hz)
+    ratio = _gain_ratio(io, f_ref_hz)
     u = jnp.linspace(np.log(f_ref_hz), np.log(f_max_hz), N_GRID)
     r = ratio(u)
     below = r < HALF_POWER
@@ -156,7 +152,7 @@ def yaw_rate_gain_peak_of(io: LinearIO, f_ref_hz, f_max_hz):
     """The largest yaw-rate gain up to ``f_max_hz`` over the gain at ``f_ref_hz`` (1; 1 when
     the gain only falls); NaN when it still rises at ``f_max_hz`` or without the trim."""
     _check_band(f_ref_hz, f_max_hz)
-    ratio, _ = _gain_ratio(io, f_ref_hz)
+    ratio = _gain_ratio(io, f_ref_hz)
     u = jnp.linspace(np.log(f_ref_hz), np.log(f_max_hz), N_GRID)
     r = ratio(u)
     k = jnp.argmax(r)
