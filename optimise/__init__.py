@@ -33,6 +33,10 @@ from ._objectives import (
     roll_rate_coefficients as roll_rate_coefficients,
     state_matrix as state_matrix,
     steering_sensitivity as steering_sensitivity,
+    step_steer_overshoot as step_steer_overshoot,
+    step_steer_peak_time as step_steer_peak_time,
+    step_steer_response_time as step_steer_response_time,
+    step_steer_steady_yaw_rate as step_steer_steady_yaw_rate,
     torsional_stiffness as torsional_stiffness,
     understeer_gradient as understeer_gradient,
 )
@@ -71,6 +75,7 @@ from ._problem import (
     solve as solve,
     target as target,
 )
+from ._step_steer import step_steer_metrics as step_steer_metrics, step_steer_run as step_steer_run
 from ._stiffness import (
     Handling as Handling,
     ModeRequirement as ModeRequirement,

@@ -18,6 +18,11 @@ Each objective wraps what jaxveh computes; none re-derives the physics:
   ``d lambda = w^H dA v / (w^H v)`` (left and right eigenvectors), as
   :func:`jaxveh.analysis.eigenvalue_sensitivities` computes it, here as a JAX rule so that
   forward and reverse mode both work;
+- the yaw-rate response of a small step steer, the yaw-rate frequency response's bandwidth
+  and peak, the four-post RMS load variation and the preview distance from the same exact
+  linearisation (:mod:`optimise._response`);
+- the yaw-rate response of a step steer of any size from the fast car's time run
+  (:mod:`optimise._step_steer`; ``step_steer_*``);
 - the chassis frame's mass and torsional stiffness (FE, :mod:`jaxveh.fe`): functions of a
   :class:`jaxveh.fe.Frame` (:data:`FRAME_OBJECTIVES`), not of ``CarParams``, whose chassis is
   the frame's modal reduction.
@@ -58,6 +63,7 @@ from ._response import (
     yaw_rate_bandwidth_of,
     yaw_rate_gain_peak_of,
 )
+from ._step_steer import SETTINGS as STEP_STEER_SETTINGS, step_steer_metrics
 
 #: Lateral acceleration (g) of the skid-pad objectives by default: the linear range.
 DEFAULT_AY_G = 0.05
@@ -420,6 +426,32 @@ def rms_fz_variation(car, speed_kmh=FOUR_POST_SPEED_KMH, **sweep):
     return _rms_fz(road_response(car, speed_kmh), **sweep)
 
 
+def step_steer_response_time(car, reverse=False, **settings):
+    """Yaw-rate response time (s) of the fast car's step steer, from 50 % of the input to
+    90 % of the steady yaw rate (ISO 7401), at any angle (:func:`optimise._step_steer.
+    step_steer_metrics`; ``settings``: ``speed_kmh``, ``angle_deg``, ``rise_s``, ``duration_s``,
+    ``settle_s``, ``rtol``; ``reverse``: ready for ``jax.grad`` instead of forward mode)."""
+    return step_steer_metrics(car, **settings, reverse=reverse).response_time
+
+
+def step_steer_peak_time(car, reverse=False, **settings):
+    """Yaw-rate peak time (s, from 50 % of the input) of the fast car's step steer (see
+    :func:`step_steer_response_time`); NaN without a peak before the settling window."""
+    return step_steer_metrics(car, **settings, reverse=reverse).peak_time
+
+
+def step_steer_overshoot(car, reverse=False, **settings):
+    """Yaw-rate overshoot (% of the steady yaw rate) of the fast car's step steer (see
+    :func:`step_steer_response_time`)."""
+    return step_steer_metrics(car, **settings, reverse=reverse).overshoot
+
+
+def step_steer_steady_yaw_rate(car, reverse=False, **settings):
+    """Steady yaw rate (deg/s) after the fast car's step steer (see
+    :func:`step_steer_response_time`): the mean over the last ``settle_s``."""
+    return step_steer_metrics(car, **settings, reverse=reverse).steady
+
+
 def preview_length(car, speed_kmh=PREVIEW_SPEED_KMH, n_preview=N_PREVIEW):
     """Preview distance Lp (m) of the TI-optimal preview driver on the linearised car at
     ``speed_kmh`` (km/h) with ``n_preview`` points (section 7.5; eq. 3.46's 98 %)."""
@@ -446,11 +478,14 @@ def torsional_stiffness(frame: fe.Frame):
 class Source(NamedTuple):
     """A computation objectives share: ``compute(car, **settings)`` and its ``settings``
     (name -> default); ``prepare(car, settings) -> {name: array}``, optional, computes
-    array settings once per study (NumPy) before anything is traced."""
+    array settings once per study (NumPy) before anything is traced; ``time_run``: whether
+    ``compute`` integrates in time and takes ``reverse`` (Diffrax's adjoint: forward mode
+    by default, reverse mode with ``reverse=True``)."""
 
     compute: Callable
     settings: dict
     prepare: Callable | None = None
+    time_run: bool = False
 
 
 def _prepare_reference(car, settings):
@@ -461,6 +496,7 @@ SOURCES = {
     "steering_response": Source(steering_response, {"speed_kmh": STEP_SPEED_KMH}),
     "road_response": Source(road_response, {"speed_kmh": FOUR_POST_SPEED_KMH}),
     "preview": Source(preview_length, {"speed_kmh": PREVIEW_SPEED_KMH, "n_preview": N_PREVIEW}),
+    "step_steer": Source(step_steer_metrics, STEP_STEER_SETTINGS, time_run=True),
     "skid_pad": Source(skid_pad_point, {"ay_g": DEFAULT_AY_G, "radius": SKID_PAD_RADIUS}),
     "load_transfer": Source(load_transfer_point, {"ay_g": tuple(LOW_AY_PAIR_G), "radius": SKID_PAD_RADIUS}),
     "linear": Source(lambda car, speed_kmh, reference: _mode(car, reference, speed_kmh),
@@ -525,6 +561,17 @@ OBJECTIVES = {
                                     "steering_response", _bandwidth, BAND_OPTIONS),
     "yaw_rate_gain_peak": Objective(yaw_rate_gain_peak, "1", "largest yaw-rate gain up to f_max_hz over the gain "
                                     "at f_ref_hz", "steering_response", _gain_peak, BAND_OPTIONS),
+    "step_steer_response_time": Objective(step_steer_response_time, "s", "yaw-rate response time of a step steer "
+                                          "of any size (50 % input to 90 % steady, ISO 7401), the fast car's time "
+                                          "run", "step_steer", lambda m: m.response_time),
+    "step_steer_peak_time": Objective(step_steer_peak_time, "s", "yaw-rate peak time of a step steer of any size "
+                                      "(from 50 % input), the fast car's time run", "step_steer",
+                                      lambda m: m.peak_time),
+    "step_steer_overshoot": Objective(step_steer_overshoot, "%", "yaw-rate overshoot of a step steer of any size, "
+                                      "the fast car's time run", "step_steer", lambda m: m.overshoot),
+    "step_steer_steady_yaw_rate": Objective(step_steer_steady_yaw_rate, "deg/s", "steady yaw rate after a step "
+                                            "steer of any size, the fast car's time run", "step_steer",
+                                            lambda m: m.steady),
     "rms_fz_variation": Objective(rms_fz_variation, "N", "RMS contact-patch load variation of one tyre over a "
                                   "four-post sine sweep (quasi-stationary, linearised car)", "road_response",
                                   _rms_fz, SWEEP_OPTIONS),
@@ -606,12 +653,13 @@ def prepare(car, specs) -> dict:
     return out
 
 
-def objective_values(car, specs, prepared=None, frame=None):
+def objective_values(car, specs, prepared=None, frame=None, reverse=False):
     """The values of the objectives ``specs`` (a tuple of :class:`ObjectiveSpec`) of ``car``
     as one array (their units, :func:`objective_units`), each shared computation done once;
     ``prepared``: :func:`prepare`'s arrays; ``frame``: the chassis frame, for the frame's
     objectives (:data:`FRAME_OBJECTIVES`). Pure and differentiable; NaN where a steady
-    state or trim failed."""
+    state, trim or time run failed. The time runs (``step_steer_*``) differentiate in forward
+    mode (``jax.jacfwd``, what studies use) or, with ``reverse``, in reverse mode (``jax.grad``)."""
     prepared = {} if prepared is None else prepared
     data = {}
     for spec in specs:
@@ -621,7 +669,9 @@ def objective_values(car, specs, prepared=None, frame=None):
                 raise ParameterError(f"objective {spec.name!r} is a function of the chassis frame: it needs the "
                                      "frame (a study with frame variables)")
         elif key not in data:
-            data[key] = SOURCES[key[0]].compute(car, **dict(key[1]), **prepared.get(key, {}))
+            source = SOURCES[key[0]]
+            extra = {"reverse": reverse} if source.time_run else {}
+            data[key] = source.compute(car, **dict(key[1]), **prepared.get(key, {}), **extra)
 
     def value(s):
         if s.source_key[0] == FRAME_SOURCE:

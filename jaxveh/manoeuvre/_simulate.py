@@ -124,7 +124,7 @@ def _driving(car, manoeuvre: Manoeuvre, trim_rack, pose: int) -> _Driving:
                     lambda t, aux: aux[k])
 
 
-def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps):
+def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint):
     del freeze_steps  # refused for the fast car, which has no projection
     driving = _driving(car, manoeuvre, trim.rack, 0)
     law, elements = driving.law, driving.elements
@@ -147,7 +147,7 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps)
     sol = diffrax.diffeqsolve(
         terms, _solver(solver), 0.0, manoeuvre.duration, FIRST_STEP, s0, saveat=diffrax.SaveAt(ts=ts),
         event=diffrax.Event(conditions), stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol),
-        max_steps=max_steps, throw=False)
+        max_steps=max_steps, throw=False, **({} if adjoint is None else {"adjoint": adjoint}))
     rolled, spun = sol.event_mask
     status = jnp.where(sol.result == diffrax.RESULTS.successful, 0,
                        jnp.where(sol.result == diffrax.RESULTS.event_occurred, 1, 2))
@@ -195,7 +195,8 @@ def _imex_terms(field, s0: FastState, n_modes: int):
     return diffrax.MultiTerm(diffrax.ODETerm(explicit), diffrax.ODETerm(implicit))
 
 
-def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps):
+def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint):
+    del adjoint  # refused for the library car (manoeuvre_channels)
     c = car.system.body_names.index("chassis")
     q_c = car.system.q_offsets[c]  # the chassis's x, y, z, yaw, pitch, roll
     chassis = slice(q_c, q_c + 6)
@@ -224,19 +225,23 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_ste
 
 
 def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, solver: str = "tsit5", rtol=1e-4,
-                       atol=1e-6, max_steps: int = 100_000, freeze_steps: int = 0):
+                       atol=1e-6, max_steps: int = 100_000, freeze_steps: int = 0, adjoint=None):
     """``(channels, stats, status)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
     in ``form`` ("fast" or "library"), from ``trim`` (default: :func:`straight_trim`): a
     pure function of the car and the manoeuvre (jit, vmap and grad through it; reverse
-    mode uses Diffrax's recursive checkpointing). ``stats``: Diffrax's counts, ``event``
+    mode uses Diffrax's recursive checkpointing; forward mode, ``jax.jvp`` and ``jax.jacfwd``,
+    needs ``adjoint=diffrax.ForwardMode()``, fast form only). ``stats``: Diffrax's counts, ``event``
     (0 or the 1-based index into :data:`EVENTS`) and ``valid`` (save times reached);
     ``status``: 0 completed, 1 stopped by an event, 2 solver failure. ``freeze_steps``
     (library form): hold the projection matrices for that many steps
     (:class:`jaxveh.multibody.ProjectedSolver`; 0: exact)."""
     run = _fast if check_form(form) == "fast" else _library
     _check_freeze_steps(freeze_steps, form)
+    if adjoint is not None and form != "fast":
+        raise ParameterError(f"adjoint = {type(adjoint).__name__}() needs form = 'fast' (the library car integrates "
+                             "with Diffrax's default adjoint)")
     trim = straight_trim(car, manoeuvre.speed, form) if trim is None else trim
-    return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps)
+    return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint)
 
 
 def _check_freeze_steps(freeze_steps, form: str) -> None:

@@ -1,0 +1,179 @@
+"""Step-steer objectives from the fast car's time run (optimise._step_steer, the
+``step_steer_*`` objectives) on the 6-mode car at 90 km/h: bad settings refused by name;
+the objectives equal ``simulate``'s step steer measured by ``step_steer_metrics``; the
+forward-mode Jacobian of a study (what ``jaxveh optimise`` calls) equals central
+differences of the same compiled values; the reverse-mode gradient (``reverse=True``)
+equals a central difference too.
+
+Compile cost: three programs of the 6-mode car's 5 s run (the plain run, its forward-mode
+Jacobian, its reverse-mode gradient), compiled once each for the module.
+"""
+
+import textwrap
+
+import equinox as eqx
+import jax
+import numpy as np
+import pytest
+
+import optimise
+from jaxveh import ParameterError, run_time_checks_off
+from jaxveh.manoeuvre import simulate, step_steer, step_steer_metrics
+from jaxveh.vehicle import load_car
+
+MODES = 6
+SPEED_KMH, ANGLE_DEG, RISE, DURATION, SETTLE = 90.0, 6.0, 0.2, 5.0, 0.5
+#: The integration's tolerance in these tests: the derivatives are those of the discrete
+#: solution, exact to about the tolerance (module docs of optimise._step_steer).
+RTOL = 1e-8
+#: Central-difference step (in the study's unconstrained variable z, and relative for the
+#: anti-roll bar) and the agreement asked of the derivatives.
+FD_STEP, FD_RTOL = 1e-3, 1e-4
+NAMES = ("step_steer_response_time", "step_steer_peak_time", "step_steer_overshoot", "step_steer_steady_yaw_rate")
+
+STUDY = f"""
+[study]
+name = "step_steer_check"
+model = "car"
+modes = {MODES}
+
+[[variables]]
+path = "chassis.stiffness_scale[0]"
+lower = 0.1
+upper = 10.0
+initial = 1.0
+log = true
+
+[[variables]]
+path = "arb_rates[0]"
+lower = 1.0
+upper = 200.0
+initial = {{arb}}
+
+[objective]
+name = "step_steer_response_time"
+minimise = true
+speed_kmh = {SPEED_KMH}
+angle_deg = {ANGLE_DEG}
+rtol = {RTOL}
+
+[[constraints]]
+name = "step_steer_peak_time"
+"<=" = 10.0
+angle_deg = {ANGLE_DEG}
+rtol = {RTOL}
+[[constraints]]
+name = "step_steer_overshoot"
+"<=" = 1000.0
+angle_deg = {ANGLE_DEG}
+rtol = {RTOL}
+[[constraints]]
+name = "step_steer_steady_yaw_rate"
+">=" = 0.01
+angle_deg = {ANGLE_DEG}
+rtol = {RTOL}
+"""
+
+
+@pytest.fixture(scope="module")
+def car():
+    return load_car(modes=MODES)
+
+
+@pytest.fixture(scope="module")
+def study(car, tmp_path_factory):
+    path = tmp_path_factory.mktemp("study") / "step_steer.toml"
+    path.write_text(textwrap.dedent(STUDY.format(arb=float(car.params.arb_rates[0]))))
+    return optimise.load_optimisation_study(path)
+
+
+@pytest.fixture(scope="module")
+def design(study):
+    return optimise.build_design(study)
+
+
+@pytest.fixture(scope="module")
+def evaluated(study, design):
+    """(z0, values, Jacobian) at the shipped car."""
+    z0 = np.asarray(design.problem.to_z({v.name: v.initial for v in study.variables}))
+    values, jac = design.evaluate(z0)
+    return z0, np.asarray(values), np.asarray(jac)
+
+
+@pytest.mark.parametrize("settings, match", [
+    ({"angle_deg": 0.0}, "angle_deg = 0.0"),
+    ({"speed_kmh": 1.0}, "speed_kmh = 1.0"),
+    ({"rise_s": 0.2, "settle_s": 5.0}, "settle_s = 5.0"),
+    ({"rtol": 0.5}, "rtol = 0.5"),
+])
+def test_bad_settings_are_refused_by_name(settings, match):
+    with pytest.raises(ParameterError, match=match):
+        optimise.step_steer_metrics(load_car(modes=0), **settings)
+
+
+def test_objectives_are_registered_with_units():
+    units = {name: optimise.objective_units(name) for name in NAMES}
+    assert units == {"step_steer_response_time": "s", "step_steer_peak_time": "s", "step_steer_overshoot": "%",
+                     "step_steer_steady_yaw_rate": "deg/s"}
+    for name in NAMES:
+        assert optimise.OBJECTIVES[name].source == "step_steer"
+    spec = optimise.objective_spec("step_steer_overshoot", {"angle_deg": 3.0})
+    assert dict(spec.settings)["angle_deg"] == 3.0
+    with pytest.raises(ParameterError, match="no setting 'angel_deg'"):
+        optimise.objective_spec("step_steer_overshoot", {"angel_deg": 3.0})
+
+
+@pytest.mark.slow
+def test_objectives_equal_the_simulated_step_steer(car, evaluated):
+    """The study's values equal ``simulate``'s step steer (same step from t = 0, same
+    tolerance, save times every 2 ms) measured by ``step_steer_metrics``: response time and
+    steady yaw rate to 1e-6, the peak (the parabola's vertex, not the largest sample)
+    within one save interval and its overshoot within 0.05 points. The step is beyond the
+    linear range: the steady yaw rate per steering-wheel degree is below the small step's."""
+    steer = step_steer(speed=SPEED_KMH / 3.6, angle=np.deg2rad(ANGLE_DEG), start=0.0, rise=RISE, duration=DURATION)
+    run = simulate(car, steer, points=2501, rtol=RTOL)
+    assert run.stop_reason == "completed"
+    measured = step_steer_metrics(run.ts, run.channels, steer.steering, settle_window=SETTLE)
+    _, values, _ = evaluated
+    response, peak, overshoot, steady = values
+    np.testing.assert_allclose(response, measured["yaw_rate_response_time_s"], rtol=1e-6)
+    np.testing.assert_allclose(steady, measured["yaw_rate_steady_deg_s"], rtol=1e-6)
+    assert abs(peak - measured["yaw_rate_peak_time_s"]) <= 0.002
+    assert abs(overshoot - measured["yaw_rate_overshoot_pct"]) <= 0.05
+    assert 0.05 < response < 0.5 and steady > 0.0
+
+
+@pytest.mark.slow
+def test_study_jacobian_equals_central_differences(design, evaluated):
+    """Forward mode (Diffrax's ForwardMode adjoint) through the trim and the run: every
+    objective's Jacobian column along each design variable equals a central difference of
+    the same compiled values (step 1e-3 in z): 1e-4."""
+    z0, values, jac = evaluated
+    assert np.all(np.isfinite(values)) and np.all(np.isfinite(jac))
+    for j in range(len(z0)):
+        dz = np.zeros_like(z0)
+        dz[j] = FD_STEP
+        plus, minus = (np.asarray(design.evaluate(z0 + s * dz)[0]) for s in (1.0, -1.0))
+        fd = (plus - minus) / (2 * FD_STEP)
+        for name, d, c in zip(NAMES, jac[:, j], fd, strict=True):
+            assert abs(d - c) <= FD_RTOL * max(abs(c), 1e-3 * abs(values[NAMES.index(name)])), (name, j, d, c)
+
+
+@pytest.mark.slow
+def test_reverse_mode_gradient_equals_central_differences(car):
+    """``reverse=True``: ``jax.grad`` of the overshoot with respect to the front anti-roll
+    bar rate (Diffrax's recursive checkpointing) equals a central difference of the same
+    function (relative step 1e-3): 1e-4."""
+
+    def overshoot(rate):
+        moved = eqx.tree_at(lambda c: c.params.arb_rates, car, car.params.arb_rates.at[0].set(rate))
+        return optimise.step_steer_overshoot(moved, reverse=True, angle_deg=ANGLE_DEG, rtol=RTOL)
+
+    rate = float(car.params.arb_rates[0])
+    with run_time_checks_off():
+        value_and_grad = eqx.filter_jit(jax.value_and_grad(overshoot))
+        value, grad = value_and_grad(rate)
+        h = FD_STEP * rate
+        fd = (float(value_and_grad(rate + h)[0]) - float(value_and_grad(rate - h)[0])) / (2 * h)
+    assert np.isfinite(float(value)) and abs(fd) > 0.0
+    np.testing.assert_allclose(float(grad), fd, rtol=FD_RTOL)
