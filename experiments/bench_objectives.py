@@ -1,7 +1,8 @@
 """Objective + gradient benchmark on the 6-mode car (issue 14): the cost of an objective's
-derivatives over the objective alone, for the steady-state metrics of the objective
-library (one skid-pad point: the understeer and rear steer gradients of
-experiments/studies/hard_points.toml).
+derivatives over the objective alone, for the objectives of a study file: by default the
+steady-state metrics of experiments/studies/hard_points.toml (one skid-pad point: the
+understeer and rear steer gradients); ``--study experiments/studies/step_steer.toml`` the
+step-steer metrics of the fast car's time run.
 
 Measures (best of ``--repeats`` calls after compilation, one process): the objectives'
 values alone (``optimise.objective_values`` under ``jax.jit``), the values with their
@@ -9,10 +10,10 @@ forward-mode Jacobian with respect to the study's design variables (what ``jaxve
 optimise`` calls every iteration: ``optimise.build_design``), and with ``--reverse`` the
 reverse-mode gradient of the first objective with respect to every floating-point leaf of
 ``CarParams`` (``jax.grad`` through the Newton solve by the implicit function theorem),
-each with its compile time. The step-steer metric's gradient is experiments/bench_car.py's
-(``grad_over_forward``).
+each with its compile time (the time runs' reverse mode: ``objective_values(...,
+reverse=True)``).
 
-    python experiments/bench_objectives.py [--reverse] [--json]
+    python experiments/bench_objectives.py [--study FILE] [--reverse] [--json]
 """
 
 import argparse
@@ -43,6 +44,7 @@ def _best(fn, *args, repeats: int = 5) -> float:
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--study", type=Path, default=STUDY, help="the study file (default: %(default)s)")
     ap.add_argument("--reverse", action="store_true", help="also the reverse-mode gradient w.r.t. every leaf")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--json", action="store_true", help="one JSON object on stdout")
@@ -52,15 +54,16 @@ def main():
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
     log = (lambda s: print(s, flush=True)) if not args.json else (lambda s: None)
 
-    study = optimise.load_optimisation_study(STUDY)
+    study = optimise.load_optimisation_study(args.study)
     design = optimise.build_design(study)
     initial = {v.name: v.initial for v in study.variables}
     z0 = np.asarray(design.problem.to_z(initial))
     car = optimise.design_car(design, initial)
     specs = design.specs
-    res = {"modes": study.modes, "objectives": [s.name for s in specs], "variables": list(initial)}
+    res = {"study": str(args.study), "modes": study.modes, "objectives": [s.name for s in specs],
+           "variables": list(initial)}
 
-    forward = eqx.filter_jit(lambda c: optimise.objective_values(c, specs))
+    forward = eqx.filter_jit(lambda c: optimise.objective_values(c, specs, design.prepared))
     with run_time_checks_off():
         values, res["forward_compile_s"] = _timed(forward, car)
         res["forward_s"] = _best(forward, car, repeats=args.repeats)
@@ -77,7 +80,8 @@ def main():
         first = specs[0]
 
         def objective(params):
-            return optimise.objective_values(eqx.tree_at(lambda c: c.params, car, params), (first,))[0]
+            moved = eqx.tree_at(lambda c: c.params, car, params)
+            return optimise.objective_values(moved, (first,), design.prepared, reverse=True)[0]
 
         grad = eqx.filter_jit(eqx.filter_value_and_grad(objective))
         with run_time_checks_off():

@@ -276,6 +276,67 @@ def test_epsilon_constraint_front(design, known, tmp_path):
         [r.optimum["lambda"] for r in front.results], abs=1e-9)
 
 
+def _slsqp_study(path, tmp_path, name, extra=""):
+    text = path.read_text().replace('method = "lbfgs"', 'method = "slsqp"') + extra
+    return optimise.load_optimisation_study(_write(tmp_path, text, name), out=tmp_path / "out")
+
+
+#: Values linear in z with the shared study's structure (:func:`_synthetic`).
+SYNTHETIC = {"understeer_gradient": (0.0, 1.0), "roll_gradient": (40.0, 100.0), "camber_gradient": (0.0, 0.0),
+             "rear_steer_gradient": (0.0, 0.0), "steering_sensitivity": (1.0, 0.0)}
+
+
+def _synthetic(design, fail_after=None):
+    """An ``evaluate`` for the shared study's objectives: value = a + b z (SYNTHETIC), NaN
+    from call ``fail_after`` on."""
+    calls = {"n": 0}
+
+    def evaluate(z):
+        calls["n"] += 1
+        a, b = (np.asarray([SYNTHETIC[s.name][i] for s in design.specs]) for i in (0, 1))
+        values = a + b * float(z[0])
+        if fail_after is not None and calls["n"] >= fail_after:
+            values = values * np.nan
+        return values, b[:, None]
+
+    return evaluate
+
+
+def test_slsqp_ends_on_an_active_bound(design, study_path, tmp_path):
+    """SciPy's SLSQP (``method = "slsqp"``) on synthetic values with the shared study's
+    structure, ku = z and the roll gradient 100 z + 40 (z the unconstrained variable): the
+    target ku = 0.5 with roll <= 50 has its optimum on the bound, z = 0.1, where SLSQP ends
+    (1e-9) converged in a few evaluations with its history; a non-finite evaluation ends it
+    with OptimisationError carrying the history and the last good design."""
+    study = _slsqp_study(study_path, tmp_path, "slsqp.toml")
+    study = study._replace(terms=tuple(t._replace(target=0.5) for t in study.terms))
+    res = optimise.optimise_study(study, design=design._replace(evaluate=_synthetic(design)))
+    z = float(design.problem.to_z(res.optimum)[0])
+    assert res.converged, res.message
+    assert abs(z - 0.1) < 1e-9 and res.evaluations <= 15
+    assert res.history[0]["evaluations"] == 1 and res.history[-1]["roll_gradient"] == pytest.approx(50.0, abs=1e-7)
+    with pytest.raises(optimise.OptimisationError, match="failed simulation at iteration") as failed:
+        optimise.optimise_study(study, design=design._replace(evaluate=_synthetic(design, fail_after=3)))
+    assert failed.value.result.failed and len(failed.value.result.history) >= 1
+
+
+@pytest.mark.slow
+def test_slsqp_finds_the_constrained_optimum_on_the_car(design, known, tmp_path):
+    """On the car (the shared 2-mode program): with the roll-gradient bound below its value
+    at the target's optimum, SLSQP ends where the roll gradient equals the bound (brentq on
+    the forward model, 1e-4), converged, in at most 30 evaluations (the augmented
+    Lagrangian took 1400-2400 on such points, docs/objectives.md)."""
+    _, lam_star, path = known
+    eps = _roll(design, lam_star - 0.03)
+    study = _slsqp_study(path, tmp_path, "tight.toml")
+    study = study._replace(constraints=tuple(c._replace(bound=eps) if c.spec.name == "roll_gradient" else c
+                                             for c in study.constraints))
+    res = optimise.optimise_study(study, design=design)
+    root = scipy.optimize.brentq(lambda x: _roll(design, x) - eps, 0.3005, lam_star, xtol=1e-12)
+    assert res.converged, res.message
+    assert abs(res.optimum["lambda"] - root) < LAMBDA_TOL and res.evaluations <= 30
+
+
 # ---- bad study files ----------------------------------------------------------------------------
 
 GOOD = """
