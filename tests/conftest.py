@@ -49,6 +49,7 @@ _MAPS, _MAX_MAPS = Path("/proc/self/maps"), Path("/proc/sys/vm/max_map_count")
 #: ``--durations=0`` (or ``JAXVEH_COMPILE_LOG``) when a module's cost changes a lot.
 MODULE_SECONDS = {
     "test_manoeuvre_fourpost.py": 2117,
+    "test_optimise_step_steer.py": 1730,
     "test_manoeuvre.py": 1655,
     "test_vehicle_car.py": 1398,
     "test_optimise_car.py": 801,
