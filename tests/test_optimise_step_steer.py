@@ -114,10 +114,11 @@ def test_bad_settings_are_refused_by_name(settings, match):
 
 
 def test_objectives_are_registered_with_units():
-    units = {name: optimise.objective_units(name) for name in NAMES}
+    names = (*NAMES, "step_steer_peak_time")
+    units = {name: optimise.objective_units(name) for name in names}
     assert units == {"step_steer_response_time": "s", "step_steer_peak_time": "s", "step_steer_overshoot": "%",
                      "step_steer_steady_yaw_rate": "deg/s"}
-    for name in NAMES:
+    for name in names:
         assert optimise.OBJECTIVES[name].source == "step_steer"
     spec = optimise.objective_spec("step_steer_overshoot", {"angle_deg": 3.0})
     assert dict(spec.settings)["angle_deg"] == 3.0
