@@ -862,10 +862,11 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
                    design: Optional[Design] = None) -> OptimisationResult:
     """Run ``study`` (module docs): L-BFGS (Optax's direction, Armijo backtracking on the
     host) or Adam on the unconstrained variables, inside augmented-Lagrangian outer
-    iterations when there are constraints. ``progress(entry)`` is called with every history
-    entry. A non-finite objective, constraint or gradient (a steady state or trim that
-    failed) ends the run: :class:`OptimisationError` with the result so far when ``throw``,
-    else that result with ``failed`` True."""
+    iterations when there are constraints, or SciPy's SLSQP with the constraints as they
+    are. ``progress(entry)`` is called with every history entry. A non-finite objective,
+    constraint or gradient (a steady state or trim that failed) ends the run:
+    :class:`OptimisationError` with the result so far when ``throw``, else that result with
+    ``failed`` True."""
     start = time.perf_counter()
     design = build_design(study) if design is None else design
     study = _with_rigid_values(study, design)
