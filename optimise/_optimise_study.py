@@ -1034,9 +1034,8 @@ def _slsqp(study, index, ev, evaluate, finite, accept, record, result, failure) 
         current["good"] = accept(at(z))
         log(current["good"])
 
-    constraints = [{"type": "ineq", "fun": lambda z, j=j: -_violations(study, index, at(z))[0][j],
-                    "jac": lambda z, j=j: -_violations(study, index, at(z))[1][j]}
-                   for j in range(len(study.constraints))]
+    constraints = [{"type": "ineq", "fun": lambda z: -_violations(study, index, at(z))[0],
+                    "jac": lambda z: -_violations(study, index, at(z))[1]}] if study.constraints else []
     log(ev)
     try:
         res = scipy.optimize.minimize(lambda z: _objective(study, index, at(z))[0], ev.z, method="SLSQP",

@@ -6,8 +6,8 @@ method: its derivative by the implicit function theorem), the steering wheel tur
 ``angle_deg`` along ``3 s^2 - 2 s^3`` from t = 0 over ``rise_s``
 (:class:`jaxveh.manoeuvre.StepSteer`), and Tsit5 with a PID step-size controller at
 ``rtol`` (``atol = rtol / 100``) integrates to ``duration_s``. The yaw rate is read off
-Diffrax's dense output every 2 ms (:func:`optimise._response.step_grid`; save times never force steps) and measured as
-the linearised car's step response is (:func:`optimise._response.step_metrics`: ISO 7401
+Diffrax's dense output every 2 ms (:func:`optimise._response.step_grid`; save times never
+force steps) and measured as the linearised car's step response is (:func:`optimise._response.step_metrics`: ISO 7401
 response time, the peak as the vertex of the parabola through the largest sample and its
 neighbours, steady value the mean over the last ``settle_s``).
 
@@ -36,15 +36,15 @@ SETTINGS = {"speed_kmh": 90.0, "angle_deg": 6.0, "rise_s": 0.2, "duration_s": 5.
 MAX_STEPS = 100_000
 
 
-def _check(speed_kmh, angle_deg, rise_s, duration_s, rtol, settle_s=0.0) -> None:
+def _check_run(speed_kmh, angle_deg, rise_s, duration_s, rtol) -> None:
     if not 5.0 <= speed_kmh <= 250.0:
         raise ParameterError(f"speed_kmh = {speed_kmh!r} is out of range: allowed [5, 250] km/h")
     if not 0.0 < abs(angle_deg) <= 180.0:
         raise ParameterError(f"angle_deg = {angle_deg!r} is out of range: allowed 0 < |angle_deg| <= 180 deg "
                              "(steering wheel; negative: right)")
-    if not (0.0 < rise_s and 0.0 <= settle_s and rise_s + settle_s < duration_s <= 60.0):
-        raise ParameterError(f"rise_s = {rise_s!r}, settle_s = {settle_s!r}, duration_s = {duration_s!r}: allowed "
-                             "rise_s > 0, settle_s > 0 and rise_s + settle_s < duration_s <= 60 s")
+    if not 0.0 < rise_s < duration_s <= 60.0:
+        raise ParameterError(f"rise_s = {rise_s!r}, duration_s = {duration_s!r}: allowed 0 < rise_s < duration_s "
+                             "<= 60 s")
     if not 1e-12 <= rtol <= 1e-2:
         raise ParameterError(f"rtol = {rtol!r} is out of range: allowed [1e-12, 1e-2]")
 
@@ -55,7 +55,7 @@ def step_steer_run(car, speed_kmh=90.0, angle_deg=6.0, rise_s=0.2, duration_s=5.
     at the save times ``ts`` (s, NumPy) and whether the run completed from a converged
     start; pure, differentiable in forward mode (``reverse=False``) or reverse mode
     (``reverse=True``)."""
-    _check(speed_kmh, angle_deg, rise_s, duration_s, rtol)
+    _check_run(speed_kmh, angle_deg, rise_s, duration_s, rtol)
     dt, _, n_steps = step_grid(rise_s, duration_s)
     ts = np.arange(n_steps + 1) * dt
     speed = jnp.asarray(speed_kmh / 3.6, jnp.float64)
@@ -73,9 +73,8 @@ def step_steer_metrics(car, speed_kmh=90.0, angle_deg=6.0, rise_s=0.2, duration_
     """Yaw-rate response time and peak time (s, from 50 % of the input), overshoot (%) and
     steady yaw rate (deg/s) of the fast car's step steer (:func:`step_steer_run`; metrics as
     :func:`optimise._response.step_metrics`); NaN where the run did not complete."""
-    if not settle_s > 0.0:
-        raise ParameterError(f"settle_s = {settle_s!r} is out of range: allowed > 0 s")
-    _check(speed_kmh, angle_deg, rise_s, duration_s, rtol, settle_s)
+    if not 0.0 < settle_s < duration_s - rise_s:
+        raise ParameterError(f"settle_s = {settle_s!r} is out of range: allowed (0, duration_s - rise_s) s")
     ts, r, ok = step_steer_run(car, speed_kmh, angle_deg, rise_s, duration_s, rtol, reverse)
     metrics = step_metrics(jnp.asarray(ts), r, rise_s, settle_s)
     return StepMetrics(*(jnp.where(ok, x, jnp.nan) for x in metrics))
