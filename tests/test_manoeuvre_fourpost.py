@@ -43,6 +43,16 @@ def lin(car):
     return analysis.linearise(car, SPEED)
 
 
+@pytest.fixture(scope="module")
+def first_mode_sensitivities(car):
+    """The eigenvalue derivatives at SPEED and the preview distance's derivative with
+    respect to µ_1, computed back to back: both run the forward-mode linearisation tangent,
+    a program that is never cached on disk (6-10 minutes to compile), so the module compiles
+    it once, before any test can drop the compiled code."""
+    eigen = analysis.eigenvalue_sensitivities(car, analysis.stiffness_direction(car, 0), SPEED)
+    return eigen, analysis.preview_distance_sensitivity(car, 0)
+
+
 # ---- the post law and the metrics ---------------------------------------------------------------
 
 def test_posts_start_flat_and_follow_the_pattern():
@@ -147,12 +157,12 @@ def test_thesis_findings_heave_is_rigid_warp_is_not(car, lin):
 
 
 @pytest.mark.slow
-def test_eigenvalue_derivatives_equal_central_differences(car, lin):
+def test_eigenvalue_derivatives_equal_central_differences(car, lin, first_mode_sensitivities):
     """d lambda / d µ_1 (the first chassis mode's stiffness multiplier) of every mode, by
     forward-mode autodiff through the trim and the Jacobian, equals central differences of
     the linearisation's eigenvalues (step 1e-4): 1e-6 of the largest derivative (measured
     below 1e-8 relative on every mode that moves)."""
-    lam, d = analysis.eigenvalue_sensitivities(car, analysis.stiffness_direction(car, 0), SPEED)
+    lam, d = first_mode_sensitivities[0]
     np.testing.assert_allclose(lam, analysis.modes(lin)[0], rtol=1e-10)
     h = 1e-4
 
@@ -388,10 +398,10 @@ def test_preview_thesis_findings_and_truncation(car):
 
 
 @pytest.mark.slow
-def test_preview_distance_derivative_equals_central_differences(car):
+def test_preview_distance_derivative_equals_central_differences(car, first_mode_sensitivities):
     """d Lp / d µ_1 by forward mode through the trim, the Jacobians and the Riccati equation
     equals central differences of the (interpolated) preview distance, step 1e-3: 1e-4."""
-    lp, dlp = analysis.preview_distance_sensitivity(car, 0)
+    lp, dlp = first_mode_sensitivities[1]
 
     def distance(scale):
         moved = eqx.tree_at(lambda c: c.params.chassis.stiffness_scale, car,
