@@ -54,8 +54,9 @@ def main():
         histories[label] = {"t_s": np.asarray(ts).tolist(), "yaw_rate_deg_s": np.asarray(yaw_rate).tolist(),
                             "ok": bool(ok)}
     first = result.history[0]
-    report = {"study": str(STUDY), "settings": settings,
-              "design": {"variables": {v.name: first[v.name] for v in study.variables}, "values": {k: first[k] for k in result.values}},
+    design_point = {"variables": {v.name: first[v.name] for v in study.variables},
+                    "values": {k: first[k] for k in result.values}}
+    report = {"study": str(STUDY), "settings": settings, "design": design_point,
               "optimum": {"variables": result.optimum, "values": result.values}, "converged": result.converged,
               "message": result.message, "iterations": result.iterations, "evaluations": result.evaluations,
               "wall_s": result.wall_s, "files": files}
