@@ -354,6 +354,24 @@ def test_shipped_study_files_load():
     assert cheap.model == "analytic"
 
 
+@pytest.mark.parametrize("name, variables, method", [
+    ("roll_balance", ["lambda"], "lbfgs"),
+    ("hard_points", ["rear_L_z"], "lbfgs"),
+    ("hard_points_pareto", ["rear_L_z"], None),
+    ("lightest_frame", None, None),
+    ("step_steer", ["front_arb", "rear_arb", "rear_L_z"], "slsqp"),
+])
+def test_shipped_optimisation_studies_load(name, variables, method):
+    """Every shipped optimisation study file passes the loader's checks (no car built)."""
+    root = Path(__file__).resolve().parents[1] / "experiments" / "studies"
+    study = optimise.load_optimisation_study(root / f"{name}.toml")
+    assert study.model == "car" and study.modes == 6
+    if variables is not None:
+        assert [v.name for v in study.variables] == variables
+    if method is not None:
+        assert study.optimiser["method"] == method
+
+
 # ---- the car ----------------------------------------------------------------------------
 
 
