@@ -357,7 +357,7 @@ def test_shipped_study_files_load():
 @pytest.mark.parametrize("name, variables, method", [
     ("roll_balance", ["lambda"], "lbfgs"),
     ("hard_points", ["rear_L_z"], "lbfgs"),
-    ("hard_points_pareto", ["rear_L_z"], None),
+    ("hard_points_pareto", ["rear_L_z"], "slsqp"),
     ("lightest_frame", None, None),
     ("step_steer", ["front_arb", "rear_arb", "rear_L_z"], "slsqp"),
 ])
