@@ -15,23 +15,16 @@ disk cache keeps them for the next run.
 
 import argparse
 import json
-import os
 from pathlib import Path
 
-import jax
 import numpy as np
+from _util import use_disk_cache
 
 import optimise
 
 STUDY = Path(__file__).with_name("studies") / "hard_points.toml"
 #: Points of the scan over the variable's bounds.
 SCAN_POINTS = 11
-
-
-def _cache() -> None:
-    folder = Path(os.environ.get("JAXVEH_CACHE", Path.home() / ".cache" / "jaxveh" / "jax"))
-    jax.config.update("jax_compilation_cache_dir", str(folder))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 
 def _values(design, point: dict) -> dict:
@@ -57,7 +50,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("results/hard_points"))
     args = ap.parse_args()
-    _cache()
+    use_disk_cache()
     base = optimise.load_optimisation_study(STUDY)
     (var,) = base.variables
     initial = {var.name: var.initial}

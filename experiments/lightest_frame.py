@@ -15,26 +15,19 @@ linearisation, differentiated in forward mode: many minutes on two cores).
 
 import argparse
 import json
-import os
 from pathlib import Path
 
-import jax
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from _util import use_disk_cache  # noqa: E402
 
 import jaxveh.fe as fe  # noqa: E402
 import optimise  # noqa: E402
 
 STUDY = Path(__file__).with_name("studies") / "lightest_frame.toml"
-
-
-def _cache() -> None:
-    folder = Path(os.environ.get("JAXVEH_CACHE", Path.home() / ".cache" / "jaxveh" / "jax"))
-    jax.config.update("jax_compilation_cache_dir", str(folder))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 
 def _derivative_check(design, point: dict, step: float = 1e-4) -> dict:
@@ -93,7 +86,7 @@ def main():
     ap.add_argument("--study", type=Path, default=STUDY)
     ap.add_argument("--out", type=Path, default=Path("results/lightest_frame"))
     args = ap.parse_args()
-    _cache()
+    use_disk_cache()
     study = optimise.load_optimisation_study(args.study, out=args.out)
     design = optimise.build_design(study)
     labels = [s.name for s in design.specs]

@@ -13,24 +13,17 @@ disk cache keeps them for the next run.
 
 import argparse
 import json
-import os
 import time
 from pathlib import Path
 
-import jax
 import numpy as np
+from _util import use_disk_cache
 
 import optimise
 
 STUDY = Path(__file__).with_name("studies") / "roll_balance.toml"
 #: λ of the scan (the bounds' interior: the design variable stays strictly inside them).
 SCAN = np.linspace(0.3005, 0.6995, 17)
-
-
-def _cache() -> None:
-    folder = Path(os.environ.get("JAXVEH_CACHE", Path.home() / ".cache" / "jaxveh" / "jax"))
-    jax.config.update("jax_compilation_cache_dir", str(folder))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 
 def _scan(design) -> list:
@@ -46,7 +39,7 @@ def main():
     ap.add_argument("--out", type=Path, default=Path("results/roll_balance"))
     ap.add_argument("--scan-only", action="store_true", help="only ku over λ on both cars")
     args = ap.parse_args()
-    _cache()
+    use_disk_cache()
     base = optimise.load_optimisation_study(STUDY)
     report = {"study": str(STUDY), "target_deg_per_g": base.terms[0].target, "ay_g": dict(base.terms[0].spec.settings)
               ["ay_g"], "radius_m": dict(base.terms[0].spec.settings)["radius"], "scan_lambda": SCAN.tolist()}

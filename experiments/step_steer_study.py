@@ -12,22 +12,15 @@ JAX's disk cache keeps them for the next run.
 
 import argparse
 import json
-import os
 from pathlib import Path
 
-import jax
 import numpy as np
+from _util import use_disk_cache
 
 import optimise
 from optimise._step_steer import step_steer_run
 
 STUDY = Path(__file__).with_name("studies") / "step_steer.toml"
-
-
-def _cache() -> None:
-    folder = Path(os.environ.get("JAXVEH_CACHE", Path.home() / ".cache" / "jaxveh" / "jax"))
-    jax.config.update("jax_compilation_cache_dir", str(folder))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 
 def _run_settings(study) -> dict:
@@ -40,7 +33,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("results/step_steer"))
     args = ap.parse_args()
-    _cache()
+    use_disk_cache()
     study = optimise.load_optimisation_study(STUDY)._replace(out=str(args.out))
     design = optimise.build_design(study)
     result = optimise.optimise_study(study, design=design, progress=lambda e: print(
