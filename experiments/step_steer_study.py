@@ -18,7 +18,6 @@ import numpy as np
 from _util import use_disk_cache
 
 import optimise
-from optimise._step_steer import step_steer_run
 
 STUDY = Path(__file__).with_name("studies") / "step_steer.toml"
 
@@ -44,7 +43,7 @@ def main():
     settings = _run_settings(study)
     histories = {}
     for label, car in (("design", design.car), ("optimum", result.car)):
-        ts, yaw_rate, ok = step_steer_run(car, **settings)
+        ts, yaw_rate, ok = optimise.step_steer_run(car, **settings)
         histories[label] = {"t_s": np.asarray(ts).tolist(), "yaw_rate_deg_s": np.asarray(yaw_rate).tolist(),
                             "ok": bool(ok)}
     first = result.history[0]
