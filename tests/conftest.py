@@ -87,12 +87,13 @@ MODULE_SECONDS = {
 #: CI sets it so that the suite ends within CI's limit on a cold compilation cache. Long
 #: tests are those marked ``slow`` and those of the heavy modules (``MODULE_SECONDS`` of
 #: 200 s or more: the modules that compile the car). Past the deadline none starts, and one
-#: still running ``ABANDON_AFTER`` seconds past it is abandoned (reported as skipped) the next
-#: time Python runs: a single test can take half an hour on a cold cache, so the deadline
-#: alone does not bound the suite (a CI run was stopped at 90 minutes with one worker inside
-#: a test it had started before the deadline). A plain ``pytest`` run has no deadline.
+#: still running ``ABANDON_AFTER`` seconds past it (``$JAXVEH_TEST_ABANDON_AFTER``; 900) is
+#: abandoned, reported as skipped, the next time Python runs: a single test can take half an
+#: hour on a cold cache, so the deadline alone does not bound the suite (a CI run was
+#: stopped at 90 minutes with one worker inside a test it had started before the deadline).
+#: A plain ``pytest`` run has no deadline.
 _DEADLINE = float(os.environ.get("JAXVEH_TEST_DEADLINE") or "inf")
-ABANDON_AFTER = 15 * 60
+ABANDON_AFTER = float(os.environ.get("JAXVEH_TEST_ABANDON_AFTER") or 15 * 60)
 _HEAVY_MODULES = {name for name, seconds in MODULE_SECONDS.items() if seconds >= 200}
 _current_test = ["(collection)"]
 _in_setup_or_call = [False]
@@ -115,7 +116,7 @@ def _abandon(signum, frame):
     """SIGALRM: abandon the long test running past the deadline (during its set-up or call;
     anywhere else in pytest's machinery, try again a second later)."""
     if _in_setup_or_call[0]:
-        pytest.skip(f"abandoned: still running {ABANDON_AFTER / 60:g} minutes past the suite's deadline "
+        pytest.skip(f"abandoned: still running {ABANDON_AFTER:.0f} s past the suite's deadline "
                     "($JAXVEH_TEST_DEADLINE, set by .ci/run); run pytest without it to run this test")
     signal.setitimer(signal.ITIMER_REAL, 1.0)
 
