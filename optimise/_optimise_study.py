@@ -59,8 +59,9 @@ design variables, a steady state with the implicit function theorem inside). Con
 Lagrangian as in :func:`optimise.solve` (``lbfgs``, ``adam``), or directly as the
 linearised inequalities of SciPy's sequential quadratic programming (``slsqp``: a BFGS
 model of the Lagrangian's Hessian, a quadratic subproblem per iteration, converged when
-the KKT conditions hold to ``tolerance``): for a few variables with active constraints it
-needs far fewer evaluations.
+the KKT conditions hold to ``tolerance``; it works on the variables' places in their
+bounds with SciPy's bounds, so that a variable can end on its bound): for a few variables
+with active constraints it needs far fewer evaluations.
 """
 
 import csv
@@ -80,6 +81,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 import scipy.optimize
+import scipy.special
 
 from jaxveh import ParameterError, run_time_checks_off, vehicle
 from jaxveh.params import UNIT_TO_SI, get_at, read_car_file, set_all
@@ -1009,38 +1011,70 @@ class _NotFinite(Exception):
         self.ev = ev
 
 
-def _slsqp(study, index, ev, evaluate, finite, accept, record, result, failure) -> OptimisationResult:
-    """SciPy's SLSQP on ``z``: the weighted objective, the constraints ``g(z) <= 0`` as
-    SciPy's ``-g >= 0``, every function and Jacobian from the one evaluation at each ``z``
-    (kept until the next ``z``). Converged when SciPy reports its KKT test passed and the
-    constraints are met to ``constraint_tol``."""
-    opts = study.optimiser
-    current = {"ev": ev, "good": ev, "logged": 0}
+#: SLSQP works on each variable's place in its bounds, ``s = sigmoid(z)`` in [0, 1] (the
+#: same linear or log scale), with SciPy's bounds [0, 1]: a variable can then end on its
+#: bound, where SLSQP's KKT test passes with the bound's multiplier (in ``z`` the bound lies
+#: at infinity, the objective flattens towards it and a bounded optimum creeps and never
+#: converges). ``s`` is held this far inside [0, 1] so that ``z`` stays finite (relative
+#: 1e-12 of the bounds' span).
+_S_EDGE = 1e-12
 
-    def at(z) -> _Evaluation:
-        if not np.array_equal(current["ev"].z, z):
-            trial = evaluate(np.array(z, dtype=float))
+
+def _z_of_s(s) -> np.ndarray:
+    s = np.clip(np.asarray(s, dtype=float), _S_EDGE, 1.0 - _S_EDGE)
+    return np.log(s) - np.log1p(-s)
+
+
+def _dz_ds(z) -> np.ndarray:
+    """``dz/ds`` at ``z`` (``s = sigmoid(z)``): the chain rule from ``z`` to ``s``."""
+    s = scipy.special.expit(z)
+    return 1.0 / (s * (1.0 - s))
+
+
+def _slsqp(study, index, ev, evaluate, finite, accept, record, result, failure) -> OptimisationResult:
+    """SciPy's SLSQP on the variables' places in their bounds ``s`` (:data:`_S_EDGE`): the
+    weighted objective, the constraints ``g <= 0`` as SciPy's ``-g >= 0``, every function
+    and Jacobian from the one evaluation at each ``s`` (kept until the next ``s``).
+    Converged when SciPy reports its KKT test passed and the constraints are met to
+    ``constraint_tol``."""
+    opts = study.optimiser
+    s0 = scipy.special.expit(ev.z)
+    current = {"s": s0, "ev": ev, "good": ev, "logged": 0}
+
+    def at(s) -> _Evaluation:
+        if not np.array_equal(current["s"], s):
+            trial = evaluate(_z_of_s(s))
             if not finite(trial):
                 raise _NotFinite(trial)
-            current["ev"] = trial
+            current["s"], current["ev"] = np.array(s, dtype=float), trial
         return current["ev"]
+
+    def objective(s):
+        e = at(s)
+        f, grad = _objective(study, index, e)
+        return f, grad * _dz_ds(e.z)
+
+    def constraints(s):
+        e = at(s)
+        g, dg = _violations(study, index, e)
+        return -g, -dg * _dz_ds(e.z)[None, :]
 
     def log(e: _Evaluation) -> None:
         f, grad = _objective(study, index, e)
         record(e, 0, f, f, grad, _violations(study, index, e)[0])
         current["logged"] += 1
 
-    def iterate(z) -> None:
-        current["good"] = accept(at(z))
+    def iterate(s) -> None:
+        current["good"] = accept(at(s))
         log(current["good"])
 
-    constraints = [{"type": "ineq", "fun": lambda z: -_violations(study, index, at(z))[0],
-                    "jac": lambda z: -_violations(study, index, at(z))[1]}] if study.constraints else []
+    cons = [{"type": "ineq", "fun": lambda s: constraints(s)[0], "jac": lambda s: constraints(s)[1]}
+            ] if study.constraints else []
     log(ev)
     try:
-        res = scipy.optimize.minimize(lambda z: _objective(study, index, at(z))[0], ev.z, method="SLSQP",
-                                      jac=lambda z: _objective(study, index, at(z))[1], constraints=constraints,
-                                      callback=iterate,
+        res = scipy.optimize.minimize(lambda s: objective(s)[0], s0, method="SLSQP",
+                                      jac=lambda s: objective(s)[1], bounds=[(0.0, 1.0)] * ev.z.shape[0],
+                                      constraints=cons, callback=iterate,
                                       options={"maxiter": opts["steps"], "ftol": opts["tolerance"]})
     except _NotFinite as bad:
         return failure(bad.ev, current["good"], f"at iteration {current['logged']}")

@@ -320,6 +320,34 @@ def test_slsqp_ends_on_an_active_bound(design, study_path, tmp_path):
     assert failed.value.result.failed and len(failed.value.result.history) >= 1
 
 
+def _synthetic_in_lambda(design, slope):
+    """An ``evaluate`` whose understeer gradient is ``slope`` λ (the physical variable, not
+    z) and whose other values are constant: its exact Jacobian in z through the bound map."""
+    lower, upper = LAM_BOUNDS
+
+    def evaluate(z):
+        lam = float(design.problem.to_values(jnp.asarray(z))["lambda"])
+        sig = (lam - lower) / (upper - lower)
+        b = np.asarray([slope if s.name == "understeer_gradient" else 0.0 for s in design.specs])
+        a = np.asarray([SYNTHETIC[s.name][0] for s in design.specs])
+        return a + b * lam, (b * (upper - lower) * sig * (1.0 - sig))[:, None]
+
+    return evaluate
+
+
+@pytest.mark.parametrize("target, bound", [(0.9, LAM_BOUNDS[1]), (0.1, LAM_BOUNDS[0])])
+def test_slsqp_ends_on_a_variable_bound(design, study_path, tmp_path, target, bound):
+    """SLSQP on synthetic values ku = λ with a target outside λ's bounds: the optimum is
+    on the bound, where SLSQP (working on λ's place in its bounds) ends converged, λ on the
+    bound to 1e-9, in a few evaluations (in the unconstrained z the bound lies at infinity
+    and the run crept towards it until its iteration limit)."""
+    study = _slsqp_study(study_path, tmp_path, "bound.toml")
+    study = study._replace(terms=tuple(t._replace(target=target) for t in study.terms))
+    res = optimise.optimise_study(study, design=design._replace(evaluate=_synthetic_in_lambda(design, 1.0)))
+    assert res.converged, res.message
+    assert abs(res.optimum["lambda"] - bound) < 1e-9 and res.evaluations <= 10
+
+
 @pytest.mark.slow
 def test_slsqp_finds_the_constrained_optimum_on_the_car(design, known, tmp_path):
     """On the car (the shared 2-mode program): with the roll-gradient bound below its value
