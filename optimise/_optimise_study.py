@@ -31,9 +31,9 @@ A study file::
 
     # [[objectives]]                  # ... or a weighted sum: the same keys plus weight = w
 
-    [[constraints]]                   # optional: f <= bound and/or f >= bound
+    [[constraints]]                   # optional: f <= bound and/or f >= bound, or f == value
     name = "roll_gradient"
-    "<=" = 1.2
+    "<=" = 1.2                        # or ">=" = ..., or "==" = ... (an equality, alone in its table)
     scale = 0.1                       # the violation's scale (default 1)
 
     [pareto]                          # optional: an ε-constraint front (optimise.pareto_front)
@@ -55,9 +55,10 @@ The optimiser works on unconstrained variables ``z`` (``optimise.Problem``'s log
 into the bounds); every iteration evaluates the objectives and constraints and their exact
 Jacobian with respect to ``z`` in one compiled forward-mode program (``jax.jacfwd``: a few
 design variables, a steady state with the implicit function theorem inside). Constraints
-``g <= 0`` (normalised by their scale) enter by the Powell-Hestenes-Rockafellar augmented
-Lagrangian as in :func:`optimise.solve` (``lbfgs``, ``adam``), or directly as the
-linearised inequalities of SciPy's sequential quadratic programming (``slsqp``: a BFGS
+``g <= 0`` and equalities ``h = 0`` (normalised by their scale) enter by the
+Powell-Hestenes-Rockafellar augmented Lagrangian as in :func:`optimise.solve` (``lbfgs``,
+``adam``), or directly as the linearised constraints of SciPy's sequential quadratic
+programming (``slsqp``: a BFGS
 model of the Lagrangian's Hessian, a quadratic subproblem per iteration, converged when
 the KKT conditions hold to ``tolerance``; it works on the variables' places in their
 bounds with SciPy's bounds, so that a variable can end on its bound): for a few variables
@@ -152,7 +153,7 @@ _KEYS = {
     "study": ("name", "description", "model", "vehicle", "modes"),
     "variables": ("path", "name", "units", "lower", "upper", "initial", "log"),
     "term": ("name", "target", "minimise", "maximise", "scale", "weight"),
-    "constraint": ("name", "<=", ">=", "scale", "reference", "relative"),
+    "constraint": ("name", "<=", ">=", "==", "scale", "reference", "relative"),
     "optimiser": tuple(DEFAULT_OPTIMISER),
     "pareto": ("constraint", "values"),
     "run": ("out",),
@@ -196,8 +197,9 @@ class Term(NamedTuple):
 
 
 class Bound(NamedTuple):
-    """A constraint ``spec <= upper`` (``kind`` "<=") or ``spec >= lower`` (">="), its
-    violation ``(f - bound) / scale`` (or ``(bound - f) / scale``) feasible when <= 0.
+    """A constraint ``spec <= upper`` (``kind`` "<="), ``spec >= lower`` (">=") or
+    ``spec == value`` ("=="), its violation ``(f - bound) / scale`` (``(bound - f) / scale``
+    for ">=") feasible when <= 0, for an equality when it is 0.
 
     With ``reference = "rigid"`` the bound is on the difference from the same objective of
     the rigid car, ``f - f_rigid`` (``relative``: ``(f - f_rigid) / |f_rigid|``, and the
@@ -231,12 +233,17 @@ class Bound(NamedTuple):
         """The violation's scale in the objective's units."""
         return self.scale * self._unit
 
+    @property
+    def is_equality(self) -> bool:
+        return self.kind == "=="
+
     def violation(self, f):
-        return ((f - self.limit) if self.kind == "<=" else (self.limit - f)) / self.limit_scale
+        """Signed and scaled: feasible when <= 0 (an inequality) or == 0 (an equality)."""
+        return self.sign * (f - self.limit) / self.limit_scale
 
     @property
     def sign(self) -> float:
-        return 1.0 if self.kind == "<=" else -1.0
+        return -1.0 if self.kind == ">=" else 1.0
 
 
 class ParetoSweep(NamedTuple):
@@ -414,9 +421,12 @@ def _constraints(where: str, tables, frame: bool = False) -> tuple[Bound, ...]:
         if not isinstance(table, dict):
             raise _err(where, key, "is not a table: write [[constraints]] tables")
         spec = _spec(where, key, table, _KEYS["constraint"], frame)
-        kinds = [k for k in ("<=", ">=") if k in table]
+        kinds = [k for k in ("<=", ">=", "==") if k in table]
         if not kinds:
-            raise _err(where, key, 'needs a bound: "<=" = VALUE and/or ">=" = VALUE')
+            raise _err(where, key, 'needs a bound: "<=" = VALUE and/or ">=" = VALUE, or "==" = VALUE')
+        if "==" in kinds and len(kinds) > 1:
+            raise _err(where, f'{key}."=="', 'is not allowed beside "<=" or ">=" in one table: an equality stands '
+                       "alone (write the bounds in their own [[constraints]] table)")
         scale = _number(where, f"{key}.scale", table.get("scale", 1.0), positive=True)
         reference, relative = table.get("reference"), table.get("relative", False)
         if reference not in (None, "rigid"):
@@ -431,15 +441,20 @@ def _constraints(where: str, tables, frame: bool = False) -> tuple[Bound, ...]:
             bound = _number(where, f'{key}."{kind}"', table[kind])
             out.append(Bound(spec=spec, kind=kind, bound=bound, scale=scale, reference=reference, relative=relative))
             bounds.setdefault((spec, reference, relative), []).append((kind, bound, key))
-    for (spec, _, _), items in bounds.items():  # the bounds on one quantity must leave an interval
-        lows = [(b, k) for kind, b, k in items if kind == ">="]
-        highs = [(b, k) for kind, b, k in items if kind == "<="]
-        if lows and highs:
-            (low, k_low), (high, k_high) = max(lows), min(highs)
-            if low > high:
-                raise _err(where, k_low, f'is infeasible: {spec.name} >= {low!r} ({k_low}) and <= {high!r} '
-                           f'({k_high}) leave no value; allowed ">=" bound <= "<=" bound')
+    for (spec, _, _), items in bounds.items():  # the bounds on one quantity must leave a value
+        _check_feasible(where, spec.name, items)
     return tuple(out)
+
+
+def _check_feasible(where: str, name: str, items) -> None:
+    """The bounds ``(kind, bound, key)`` on one quantity leave at least one value."""
+    lows = [(b, k) for kind, b, k in items if kind in (">=", "==")]
+    highs = [(b, k) for kind, b, k in items if kind in ("<=", "==")]
+    if lows and highs:
+        (low, k_low), (high, k_high) = max(lows), min(highs)
+        if low > high:
+            raise _err(where, k_low, f"is infeasible: {name} >= {low!r} ({k_low}) and <= {high!r} ({k_high}) leave "
+                       'no value; allowed ">=" bound <= "<=" bound, and one "==" value inside them')
 
 
 def _optimiser(where: str, table) -> dict:
@@ -839,7 +854,7 @@ def _objective(study, index, ev: _Evaluation):
 
 
 def _violations(study, index, ev: _Evaluation):
-    """(constraint violations g, normalised: feasible <= 0; their Jacobian in z)."""
+    """(constraint violations g, normalised: feasible <= 0, equalities 0; their Jacobian in z)."""
     g = np.asarray([float(c.violation(ev.values[index[c.spec]])) for c in study.constraints])
     dg = np.asarray([c.sign / c.limit_scale * ev.jac[index[c.spec]] for c in study.constraints])
     return g, dg.reshape(len(study.constraints), ev.z.shape[0])
@@ -854,10 +869,25 @@ def _merit(study, index, ev: _Evaluation, multipliers, rho):
         k = index[c.spec]
         g = float(c.violation(ev.values[k]))
         violations[j] = g
-        active = max(0.0, multipliers[j] + rho * g)
+        active = multipliers[j] + rho * g
+        if not c.is_equality:
+            active = max(0.0, active)
         merit += (active**2 - multipliers[j] ** 2) / (2.0 * rho)
         grad = grad + active * c.sign / c.limit_scale * ev.jac[k]
     return f, merit, grad, violations
+
+
+def _infeasibility(study, violations) -> float:
+    """The largest constraint violation: an inequality's positive part, an equality's size."""
+    return max((abs(g) if c.is_equality else max(0.0, g) for c, g in zip(study.constraints, violations)),
+               default=0.0)
+
+
+def _update_multipliers(study, multipliers, violations, rho) -> np.ndarray:
+    """PHR multiplier update: inequalities' multipliers stay >= 0, equalities' are free."""
+    updated = multipliers + rho * np.asarray(violations)
+    equality = np.asarray([c.is_equality for c in study.constraints], dtype=bool)
+    return np.where(equality, updated, np.maximum(0.0, updated))
 
 
 def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None, throw: bool = True,
@@ -987,11 +1017,11 @@ def optimise_study(study: OptimisationStudy, progress: Optional[Callable] = None
                 ev = accept(accepted)
             f, merit, grad, violations = _merit(study, index, ev, multipliers, rho)
             record(ev, outer, f, merit, grad, violations)
-        worst = float(np.max(violations, initial=0.0))
+        worst = _infeasibility(study, violations)
         if not study.constraints:
             converged = inner_converged or np.linalg.norm(grad) <= opts["tolerance"]
             break
-        multipliers = np.maximum(0.0, multipliers + rho * violations)
+        multipliers = _update_multipliers(study, multipliers, violations, rho)
         if worst > opts["constraint_tol"]:
             rho *= opts["rho_growth"]
         elif inner_converged:
@@ -1033,7 +1063,8 @@ def _dz_ds(z) -> np.ndarray:
 
 def _slsqp(study, index, ev, evaluate, finite, accept, record, result, failure) -> OptimisationResult:
     """SciPy's SLSQP on the variables' places in their bounds ``s`` (:data:`_S_EDGE`): the
-    weighted objective, the constraints ``g <= 0`` as SciPy's ``-g >= 0``, every function
+    weighted objective, the constraints ``g <= 0`` as SciPy's ``-g >= 0`` and the
+    equalities as its ``"eq"`` constraints, every function
     and Jacobian from the one evaluation at each ``s`` (kept until the next ``s``).
     Converged when SciPy reports its KKT test passed and the constraints are met to
     ``constraint_tol``."""
@@ -1068,8 +1099,10 @@ def _slsqp(study, index, ev, evaluate, finite, accept, record, result, failure) 
         current["good"] = accept(at(s))
         log(current["good"])
 
-    cons = [{"type": "ineq", "fun": lambda s: constraints(s)[0], "jac": lambda s: constraints(s)[1]}
-            ] if study.constraints else []
+    equality = np.asarray([c.is_equality for c in study.constraints], dtype=bool)
+    cons = [{"type": kind, "fun": lambda s, rows=rows: constraints(s)[0][rows],
+             "jac": lambda s, rows=rows: constraints(s)[1][rows]}
+            for kind, rows in (("ineq", ~equality), ("eq", equality)) if rows.any()]
     log(ev)
     try:
         res = scipy.optimize.minimize(lambda s: objective(s)[0], s0, method="SLSQP",
@@ -1081,7 +1114,7 @@ def _slsqp(study, index, ev, evaluate, finite, accept, record, result, failure) 
     final = accept(at(res.x))
     if not np.array_equal(final.z, current["good"].z):
         log(final)
-    worst = float(np.max(_violations(study, index, final)[0], initial=0.0))
+    worst = _infeasibility(study, _violations(study, index, final)[0])
     converged = bool(res.success) and worst <= opts["constraint_tol"]
     message = f"SLSQP: {res.message}" + ("" if worst <= opts["constraint_tol"] else
                                          f" (largest constraint violation {worst:.3g})")

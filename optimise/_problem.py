@@ -6,9 +6,9 @@ A design variable is a leaf of the parameter pytree named by its attribute path
 lives in ``[lower, upper]`` through a logistic map of an unconstrained variable (in log space
 with ``log=True``), so every Optax step stays feasible for the bounds.
 
-Constraints are scalar functions ``g(params) <= 0`` handled by the Powell-Hestenes-
-Rockafellar augmented Lagrangian: outer multiplier updates around ``inner_steps`` Optax
-steps.
+Constraints are scalar functions ``g(params) <= 0`` and equalities ``h(params) = 0``,
+handled by the Powell-Hestenes-Rockafellar augmented Lagrangian: outer multiplier updates
+around ``inner_steps`` Optax steps.
 """
 
 import math
@@ -53,13 +53,15 @@ def target(fn: Callable, value: float, scale: float = 1.0) -> Callable:
 
 
 class Problem(eqx.Module):
-    """``minimise objective(params)`` subject to ``constraint(params) <= 0`` for each constraint.
+    """``minimise objective(params)`` subject to ``constraint(params) <= 0`` for each constraint
+    and ``equality(params) = 0`` for each equality.
 
     Attributes:
         params: base parameter pytree (e.g. an ``AnalyticVehicle``).
         variables: the design variables.
         objective: scalar function of the parameter pytree.
         constraints: scalar functions of the parameter pytree, feasible when <= 0.
+        equalities: scalar functions of the parameter pytree, feasible when 0.
         apply: ``apply(params, {name: value}) -> params``; default :func:`set_leaves`.
     """
 
@@ -68,6 +70,7 @@ class Problem(eqx.Module):
     objective: Callable = eqx.field(static=True)
     constraints: tuple[Callable, ...] = eqx.field(static=True, default=())
     apply: Optional[Callable] = eqx.field(static=True, default=None)
+    equalities: tuple[Callable, ...] = eqx.field(static=True, default=())
 
     def __check_init__(self):
         if not self.variables:
@@ -120,21 +123,28 @@ class Problem(eqx.Module):
 
 
 class Result(NamedTuple):
-    """Solution: variable values, parameter pytree, objective, constraint values, history."""
+    """Solution: variable values, parameter pytree, objective, constraint and equality
+    values, history."""
 
     values: dict
     params: object
     objective: float
     constraints: list
     history: list
+    equalities: list = []
 
 
 def _lagrangian(problem: Problem, z, multipliers, rho):
+    """The PHR augmented Lagrangian; ``multipliers``: the constraints' then the equalities'."""
     params = problem.build(z)
     value = problem.objective(params)
+    n_con = len(problem.constraints)
     for k, g in enumerate(problem.constraints):
         c = g(params)
         value = value + (jnp.maximum(0.0, multipliers[k] + rho * c) ** 2 - multipliers[k] ** 2) / (2.0 * rho)
+    for k, h in enumerate(problem.equalities, start=n_con):
+        e = h(params)
+        value = value + multipliers[k] * e + 0.5 * rho * e**2
     return value
 
 
@@ -165,7 +175,7 @@ def solve(
 
     Each outer iteration runs ``inner_steps`` optimiser steps on the augmented Lagrangian
     (one compiled ``lax.scan``), then updates multipliers and grows the penalty while the
-    worst constraint violation exceeds ``constraint_tol``. Raises ``RuntimeError`` if the
+    worst constraint violation (or an equality's size) exceeds ``constraint_tol``. Raises ``RuntimeError`` if the
     objective or gradient becomes non-finite. Settings are checked (``ParameterError``):
     ``inner_steps``, ``outer_steps`` >= 1, ``rho`` > 0, ``rho_growth`` >= 1,
     ``constraint_tol`` > 0. Parameter values out of their physical range during the solve
@@ -175,8 +185,8 @@ def solve(
                     constraint_tol=constraint_tol)
     optimiser = optax.adam(0.05) if optimiser is None else optimiser
     z = problem.to_z(initial)
-    n_con = len(problem.constraints)
-    multipliers = jnp.zeros(n_con)
+    n_con, n_eq = len(problem.constraints), len(problem.equalities)
+    multipliers = jnp.zeros(n_con + n_eq)
 
     @eqx.filter_jit
     def inner(z, multipliers, rho):
@@ -198,7 +208,11 @@ def solve(
     @eqx.filter_jit
     def evaluate(z):
         params = problem.build(z)
-        return problem.objective(params), jnp.stack([g(params) for g in problem.constraints]) if n_con else jnp.zeros(0)
+        fns = problem.constraints + problem.equalities
+        return problem.objective(params), jnp.stack([g(params) for g in fns]) if fns else jnp.zeros(0)
+
+    def infeasibility(cons):
+        return float(jnp.max(jnp.concatenate([jnp.maximum(cons[:n_con], 0.0), jnp.abs(cons[n_con:])]), initial=0.0))
 
     history = []
     rho = jnp.asarray(rho, dtype=jnp.float64)
@@ -208,11 +222,12 @@ def solve(
             raise RuntimeError("optimisation produced a non-finite objective or design; check bounds and the objective")
         obj, cons = evaluate(z)
         values = {k: float(v) for k, v in problem.to_values(z).items()}
-        history.append({"objective": float(obj), "max_violation": float(jnp.max(cons, initial=0.0)), **values})
-        if n_con == 0:
+        history.append({"objective": float(obj), "max_violation": infeasibility(cons), **values})
+        if n_con + n_eq == 0:
             break
-        multipliers = jnp.maximum(0.0, multipliers + rho * cons)
-        if float(jnp.max(cons, initial=0.0)) > constraint_tol:
+        updated = multipliers + rho * cons
+        multipliers = jnp.concatenate([jnp.maximum(0.0, updated[:n_con]), updated[n_con:]])
+        if infeasibility(cons) > constraint_tol:
             rho = rho * rho_growth
         elif len(history) > 1 and abs(history[-1]["objective"] - history[-2]["objective"]) <= 1e-9 * max(
             1.0, abs(history[-1]["objective"])
@@ -224,6 +239,7 @@ def solve(
         values=values,
         params=problem.build(z),
         objective=float(obj),
-        constraints=[float(c) for c in cons],
+        constraints=[float(c) for c in cons[:n_con]],
         history=history,
+        equalities=[float(c) for c in cons[n_con:]],
     )

@@ -348,6 +348,26 @@ def test_slsqp_ends_on_a_variable_bound(design, study_path, tmp_path, target, bo
     assert abs(res.optimum["lambda"] - bound) < 1e-9 and res.evaluations <= 10
 
 
+@pytest.mark.parametrize("method", ["slsqp", "lbfgs"])
+@pytest.mark.parametrize("value, z_star", [(45.0, 0.05), (95.0, 0.55)])
+def test_equality_constraint(design, study_path, tmp_path, method, value, z_star):
+    """An equality on synthetic values (roll gradient 100 z + 40, ku = z, target ku = 0.5):
+    ``"==" = 45`` and ``"==" = 95`` hold the optimum at z = 0.05 and 0.55, either side of
+    the target's (so the multiplier takes either sign; ``<= 95`` would be inactive), with
+    SciPy's SLSQP and with the augmented Lagrangian around L-BFGS; converged, the equality
+    met to 1e-7 and reported with its kind."""
+    study = _slsqp_study(study_path, tmp_path, "equality.toml")
+    opts = {**study.optimiser, "method": method, "outer_steps": 30}
+    study = study._replace(terms=tuple(t._replace(target=0.5) for t in study.terms), optimiser=opts,
+                           constraints=tuple(c._replace(kind="==", bound=value) if c.spec.name == "roll_gradient"
+                                             else c for c in study.constraints))
+    res = optimise.optimise_study(study, design=design._replace(evaluate=_synthetic(design)))
+    assert res.converged, res.message
+    assert float(design.problem.to_z(res.optimum)[0]) == pytest.approx(z_star, abs=1e-9)
+    roll = next(c for c in res.constraints if c["name"] == "roll_gradient")
+    assert roll["kind"] == "==" and abs(roll["value"] - value) < 1e-7
+
+
 @pytest.mark.slow
 def test_slsqp_finds_the_constrained_optimum_on_the_car(design, known, tmp_path):
     """On the car (the shared 2-mode program): with the roll-gradient bound below its value
@@ -392,6 +412,12 @@ target = 0.1
     ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"\n">=" = 0.6\n[[constraints]]\nname = "chi"\n'
      '"<=" = 0.5', "constraints[0] is infeasible: chi >= 0.6 (constraints[0]) and <= 0.5 (constraints[1])"),
     ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"', 'constraints[0] needs a bound: "<=" = VALUE'),
+    ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"\n"==" = 0.45\n"<=" = 0.5',
+     'constraints[0]."==" is not allowed beside "<=" or ">=" in one table: an equality stands alone'),
+    ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"\n">=" = 0.6\n[[constraints]]\nname = "chi"\n'
+     '"==" = 0.5', "constraints[0] is infeasible: chi >= 0.6 (constraints[0]) and <= 0.5 (constraints[1])"),
+    ("target = 0.1", 'target = 0.1\n[[constraints]]\nname = "chi"\n"==" = 0.4\n[[constraints]]\nname = "chi"\n'
+     '"==" = 0.5', "constraints[1] is infeasible: chi >= 0.5 (constraints[1]) and <= 0.4 (constraints[0])"),
     ('name = "understeer_gradient"', 'name = "chassis_mass"', "is an objective of the chassis frame"),
     ("target = 0.1", "target = 0.1\nminimise = true", "needs exactly one of target = VALUE, minimise = true"),
     ("target = 0.1", "target = 0.1\nspeed = 3.0", "objective.speed is not a key of objective 'understeer_gradient'"),

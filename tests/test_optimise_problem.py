@@ -108,3 +108,26 @@ def test_optimiser_leaving_the_physical_range_raises_named_error(vehicle):
     problem = Problem(vehicle, (Variable("kF", -5000.0, 20000.0),), lambda v: analytic.roll_stiffness_proportion(v))
     with pytest.raises(eqx.EquinoxRuntimeError, match=r"AnalyticVehicle\.kF must lie in \[0, inf\)"):
         solve(problem, {"kF": 1000.0}, optax.sgd(1.0), inner_steps=50, outer_steps=1)
+
+
+@pytest.mark.parametrize("pull", [0.1, 0.9])
+def test_equality_constraint_pins_understeer_gradient(vehicle, pull):
+    """An equality ku(λ) = 0.76 deg/g with an objective pulling λ towards ``pull`` (below and
+    above the root, so the multiplier takes either sign): the solve ends on brentq's λ
+    (1e-4) with the equality met, where an inequality would have been inactive one side."""
+    flex = analytic.with_distribution(vehicle, mu=1.0)
+
+    def ku(v):
+        return analytic.understeer_gradient(v) * analytic.RAD_PER_MS2_TO_DEG_PER_G
+
+    def objective(v):
+        return (analytic.roll_stiffness_proportion(v) - pull) ** 2
+
+    problem = Problem(flex, (Variable("lam", 0.05, 0.95),), objective,
+                      apply=lambda v, values: analytic.with_distribution(v, lam=values["lam"]),
+                      equalities=(lambda v: (ku(v) - 0.76) / 0.01,))
+    result = solve(problem, {"lam": 0.5}, optax.adam(0.02), inner_steps=400, outer_steps=20)
+    root = scipy.optimize.brentq(lambda lam: float(ku(analytic.with_distribution(flex, lam=lam))) - 0.76, 0.05, 0.95)
+    assert result.values["lam"] == pytest.approx(root, abs=1e-4)
+    assert result.constraints == [] and abs(result.equalities[0]) < 1e-3
+    assert result.history[-1]["max_violation"] == pytest.approx(abs(result.equalities[0]), rel=1e-6, abs=1e-12)
