@@ -2,6 +2,12 @@
 constraints, solved with Optax (augmented Lagrangian around a gradient optimiser); study
 files and sensitivity maps at scale (``sweep``: chunked vmap, checkpoints, Ray)."""
 
+from ._car_file import (
+    CAR_FILE_KEYS as CAR_FILE_KEYS,
+    changed_car_values as changed_car_values,
+    file_entries as file_entries,
+    optimum_car_file as optimum_car_file,
+)
 from ._frame_design import (
     FRAME_QUANTITIES as FRAME_QUANTITIES,
     FrameVariable as FrameVariable,
@@ -41,7 +47,6 @@ from ._objectives import (
     understeer_gradient as understeer_gradient,
 )
 from ._optimise_study import (
-    CAR_FILE_KEYS as CAR_FILE_KEYS,
     METHODS as METHODS,
     Bound as Bound,
     Design as Design,
@@ -54,7 +59,6 @@ from ._optimise_study import (
     design_car as design_car,
     load_optimisation_study as load_optimisation_study,
     optimise_study as optimise_study,
-    optimum_car_file as optimum_car_file,
     optimum_frame_file as optimum_frame_file,
     result_report as result_report,
     rigid_values as rigid_values,

@@ -72,7 +72,6 @@ import math
 import re
 import time
 from collections.abc import Callable
-from importlib import resources
 from pathlib import Path
 from typing import NamedTuple, Optional
 
@@ -85,9 +84,10 @@ import scipy.optimize
 import scipy.special
 
 from jaxveh import ParameterError, run_time_checks_off, vehicle
-from jaxveh.params import UNIT_TO_SI, get_at, read_car_file, set_all
+from jaxveh.params import set_all
 from jaxveh.vehicle import CORNERS
 
+from ._car_file import changed_car_values, optimum_car_file
 from ._frame_design import (
     car_with_frame,
     check_frame_variables,
@@ -140,8 +140,7 @@ ARMIJO_C1, MAX_HALVINGS = 1e-4, 30
 #: The parts of CarParams the λ label's rate coefficients depend on: a study may not vary
 #: them together with λ (:func:`optimise.arb_rates_for_lambda`).
 LAMBDA_EXCLUDES = ("vehicle", "springs", "arb_rates")
-#: CarParams paths written back into a car file: path -> (section, key, unit of the file).
-CAR_FILE_KEYS = {
+_KEYS = {
     "arb_rates[0]": ("suspension_front", "arb_rate", "Nm/rad"),
     "arb_rates[1]": ("suspension_rear", "arb_rate", "Nm/rad"),
     "coupling": ("chassis", "coupling", "-"),
@@ -1150,73 +1149,6 @@ def result_report(result: OptimisationResult, files: Optional[dict] = None) -> d
         "files": files or {},
         "history": result.history,
     }
-
-
-def changed_car_values(result: OptimisationResult) -> dict:
-    """``{path: value}`` (SI) of the car-file values (:data:`CAR_FILE_KEYS`) that differ
-    between the study's base car and the optimum."""
-    base = vehicle.load_car(result.study.vehicle, modes=0).params  # the bars, coupling, rack: as any mode count
-    out = {}
-    for path in CAR_FILE_KEYS:
-        new = float(get_at(result.car.params, path))
-        if new != float(get_at(base, path)):
-            out[path] = new
-    return out
-
-
-def _car_text(study: OptimisationStudy) -> str:
-    if study.vehicle is None:
-        return (resources.files("jaxveh.params") / "data" / "car.toml").read_text()
-    return Path(study.vehicle).read_text()
-
-
-def _set_value(text: str, section: str, key: str, value: str) -> str:
-    """``text`` (TOML) with ``key = value`` in ``[section]``: the value of an existing line
-    replaced (its comment kept), or a line added after the section's header."""
-    lines = text.splitlines(keepends=True)
-    header = re.compile(rf"^\s*\[{re.escape(section)}\]\s*(#.*)?$")
-    start = next((i for i, line in enumerate(lines) if header.match(line.rstrip("\n"))), None)
-    if start is None:
-        return text.rstrip("\n") + f"\n\n[{section}]\n{key} = {value}\n"
-    end = next((i for i in range(start + 1, len(lines)) if re.match(r"^\s*\[", lines[i])), len(lines))
-    pattern = re.compile(rf"^(\s*{re.escape(key)}\s*=\s*)([^#\n]*?)(\s*(#.*)?)$")
-    for i in range(start + 1, end):
-        m = pattern.match(lines[i].rstrip("\n"))
-        if m:
-            lines[i] = f"{m.group(1)}{value}{m.group(3)}\n"
-            return "".join(lines)
-    lines.insert(start + 1, f"{key} = {value}\n")
-    return "".join(lines)
-
-
-def optimum_car_file(result: OptimisationResult, frame_file=None) -> str:
-    """The base car file's text with the optimum's changed values written in (only those,
-    in the file's units; :data:`CAR_FILE_KEYS`), its ``[files]`` made absolute where they
-    were paths relative to the base file (``frame_file``: the optimum's frame file, for a
-    study with frame variables), and a header naming the study. A car file for
-    ``--vehicle``."""
-    study = result.study
-    text = _car_text(study)
-    changed = changed_car_values(result)
-    for path, value in changed.items():
-        section, key, unit = CAR_FILE_KEYS[path]
-        text = _set_value(text, section, key, repr(value / UNIT_TO_SI[unit]))
-    if study.vehicle is not None:  # tyre and frame files relative to the base file: absolute in the copy
-        files = read_car_file(study.vehicle).files
-        for key, name in files.items():
-            if Path(name).is_file() and not Path(name).is_absolute():
-                text = _set_value(text, "files", key, json.dumps(str(Path(name).resolve())))
-    if frame_file is not None:
-        text = _set_value(text, "files", "frame", json.dumps(str(Path(frame_file).resolve())))
-    unwritten = [v.path for v in study.variables
-                 if v.path != "lambda" and v.path not in CAR_FILE_KEYS and not is_frame_path(v.path)]
-    head = [f"# The optimum of the study {study.name!r} ({study.file or 'built in Python'}), written by jaxveh "
-            "optimise:", "# " + ", ".join(f"{k} = {v:.10g}" for k, v in result.optimum.items()) +
-            f" (converged: {str(result.converged).lower()})"]
-    if unwritten:
-        head.append("# Not in a car file (set them with --param): " + ", ".join(
-            f"{p} = {float(get_at(result.car.params, p)):.10g}" for p in unwritten))
-    return "\n".join(head) + "\n" + text
 
 
 def frame_sizes(result: OptimisationResult) -> tuple:

@@ -13,8 +13,10 @@ test shares one study (:data:`STUDY`: one compiled program), whose constraints a
 from active, so its optimum is the understeer-gradient target's alone.
 """
 
+import difflib
 import json
 import textwrap
+from pathlib import Path
 
 import jax
 import jax.numpy as jnp
@@ -519,3 +521,45 @@ def test_rear_steer_gradient_of_the_axle():
         _rear_steer_gradient(pad, "front_left")
     spec = optimise.objective_spec("rear_steer_gradient", {"corner": "rear"})
     assert dict(spec.settings)["corner"] == "rear"
+
+
+def test_optimum_car_file_carries_hard_points_and_stiffness_multipliers(design, study_path, tmp_path):
+    """The optimum's car file holds every changed value a car file can hold — a hard-point
+    coordinate, a whole hard point, a mode's stiffness multiplier µ, a bar rate, the sprung
+    mass, the tyre rate, a controller gain — in the file's units: read back by load_car it
+    gives the optimum's parameters (1e-12); only the changed lines differ from the base
+    file; a variable no car file holds is named in the header."""
+    car = design.car
+    changes = {"vehicle.hard_points_rear.points[7, 2]": 0.3191, "vehicle.hard_points_front.points[8, 0]": -0.0605,
+               "vehicle.hard_points_front.points[8, 1]": 0.5412, "chassis.stiffness_scale[1]": 3.5,
+               "arb_rates[0]": 25.0, "vehicle.sprung.mass": 231.5, "vehicle.tyre.kz": 161000.0, "pid.kp": 280.0,
+               "springs.bump_stop_rate[0]": 1.5e5}
+    optimum_car = with_params(car, changes)
+    study = optimise.load_optimisation_study(study_path)
+    variables = tuple(optimise.DesignVariable(name=f"v{i}", path=p, lower=-1e9, upper=1e9, initial=0.0)
+                      for i, p in enumerate(changes))
+    study = study._replace(variables=variables)
+    result = optimise.OptimisationResult(study=study, optimum={v.name: 0.0 for v in variables}, objective=0.0,
+                                         values={}, constraints=[], converged=True, message="", iterations=0,
+                                         evaluations=0, history=[], car=optimum_car, failed=False, wall_s=0.0)
+    text = optimise.optimum_car_file(result)
+    path = tmp_path / "optimum_car.toml"
+    path.write_text(text)
+    reloaded = load_car(path, modes=MODES)
+    for p in changes:
+        if not p.startswith("springs"):
+            np.testing.assert_allclose(np.asarray(optimise.get_leaf(reloaded.params, p)), np.asarray(changes[p]),
+                                       rtol=1e-12, err_msg=p)
+    assert float(reloaded.params.chassis.stiffness_scale[0]) == 1.0
+    assert "# Not in a car file (set them with --param): springs.bump_stop_rate[0] = 150000" in text
+    base = (Path(__file__).parents[1] / "jaxveh" / "params" / "data" / "car.toml").read_text().splitlines()
+    new = text.splitlines()[3:]
+    diff = list(difflib.ndiff(base, new))
+    changed = [line[2:] for line in diff if line.startswith("+ ")]
+    assert sum(line.startswith("- ") for line in diff) == 6 and len(changed) == 7  # stiffness_scale is a new line
+    assert set(optimise.changed_car_values(result)) == {
+        "vehicle.hard_points_rear.points[7]", "vehicle.hard_points_front.points[8]", "chassis.stiffness_scale",
+        "arb_rates[0]", "vehicle.sprung.mass", "vehicle.tyre.kz", "pid.kp"}
+    assert any(line.startswith("L = [-61.0, 248.8, 319.1]") for line in changed)
+    assert any(line.startswith("M = [-60.5, 541.2, 344.0]") for line in changed)
+    assert "stiffness_scale = [1.0, 3.5]" in changed

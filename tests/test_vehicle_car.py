@@ -240,6 +240,24 @@ def test_car_file_errors_name_the_field(tmp_path):
         vehicle.load_car(unknown, modes=0)
 
 
+def test_car_file_stiffness_multipliers(tmp_path):
+    """``[chassis] stiffness_scale``: the listed modes take the file's µ, the rest keep 1, a
+    rigid car ignores it; a bad list is refused naming the key and what is allowed."""
+    from importlib import resources
+
+    text = resources.files("jaxveh.params").joinpath("data/car.toml").read_text()
+    path = tmp_path / "scaled.toml"
+    path.write_text(text.replace("[chassis]\n", "[chassis]\nstiffness_scale = [2.5, 0.5]\n"))
+    np.testing.assert_array_equal(vehicle.load_car(path, modes=3).params.chassis.stiffness_scale, [2.5, 0.5, 1.0])
+    np.testing.assert_array_equal(vehicle.load_car(path, modes=1).params.chassis.stiffness_scale, [2.5])
+    assert vehicle.load_car(path, modes=0).params.chassis is None
+    for value in ("[]", "[1.0, -2.0]", "[1.0, true]", '"stiff"', "[" + ", ".join(["1.0"] * 21) + "]"):
+        path.write_text(text.replace("[chassis]\n", f"[chassis]\nstiffness_scale = {value}\n"))
+        with pytest.raises(ParameterError, match=r"\[chassis\]\.stiffness_scale = .* is not allowed: a list of 1 to "
+                                                 r"20 numbers > 0"):
+            vehicle.load_car(path, modes=0)
+
+
 def test_form_is_checked():
     with pytest.raises(ParameterError, match="form = 'quick'.*'fast', 'library'"):
         vehicle.load_car(form="quick", modes=0)

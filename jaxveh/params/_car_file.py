@@ -4,6 +4,7 @@ and frame files, chassis damping). :func:`read_car_file` validates it and return
 :mod:`jaxveh.vehicle` turns them into the car.
 """
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,6 +47,10 @@ CHASSIS = (
              lower_open=False, upper=1.0),
 )
 FILES = ("tyre_front", "tyre_rear", "frame")
+#: The optional list key of ``[chassis]``: each mode's stiffness multiplier µ (mode 1 first).
+STIFFNESS_SCALE = "stiffness_scale"
+#: The most modes a car has (``load_car``'s ``modes``).
+MAX_MODES = 20
 SECTIONS = {"suspension_front": SUSPENSION, "suspension_rear": SUSPENSION, "steering": STEERING, "aero": AERO,
             "powertrain": POWERTRAIN, "chassis": CHASSIS}
 
@@ -54,12 +59,30 @@ SECTIONS = {"suspension_front": SUSPENSION, "suspension_rear": SUSPENSION, "stee
 class CarFile:
     """A validated car file: ``vehicle`` (Appendix B), ``sections`` (SI values by section
     and key), ``files`` (tyre and frame files: a shipped name or a path resolved against
-    the car file's folder) and ``where`` (the file, for messages)."""
+    the car file's folder), ``stiffness_scale`` (``[chassis] stiffness_scale``: each
+    mode's stiffness multiplier µ from mode 1, ``()`` when absent) and ``where`` (the
+    file, for messages)."""
 
     vehicle: VehicleData
     sections: dict
     files: dict
     where: str
+    stiffness_scale: tuple = ()
+
+
+def _stiffness_scale(table, where: str) -> tuple:
+    """``[chassis] stiffness_scale`` (removed from ``table``'s chassis section): a list of
+    1-20 finite numbers > 0, or absent."""
+    chassis = table.get("chassis")
+    if not isinstance(chassis, dict) or STIFFNESS_SCALE not in chassis:
+        return ()
+    value = chassis.pop(STIFFNESS_SCALE)
+    ok = isinstance(value, list) and 1 <= len(value) <= MAX_MODES and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0 for v in value)
+    if not ok:
+        raise ParameterError(f"{where} [chassis].{STIFFNESS_SCALE} = {value!r} is not allowed: a list of 1 to "
+                             f"{MAX_MODES} numbers > 0, each mode's stiffness multiplier µ from mode 1")
+    return tuple(float(v) for v in value)
 
 
 def _files(table, where: str, folder: Path | None) -> dict:
@@ -84,7 +107,9 @@ def read_car_file(path: str | Path | None = None) -> CarFile:
     """Read and validate a car file (default: the shipped ``car.toml``)."""
     table, where = read_toml(path, "jaxveh.params", "data/car.toml", "car")
     check_sections(table, (*APPENDIX_B_SECTIONS, *SECTIONS, "files"), where)
+    stiffness_scale = _stiffness_scale(table, where)
     vehicle = vehicle_data_from_dict({k: table[k] for k in APPENDIX_B_SECTIONS if k in table}, where)
     sections = {name: read_section(table, name, quantities, where) for name, quantities in SECTIONS.items()}
     folder = None if path is None else Path(path).parent
-    return CarFile(vehicle=vehicle, sections=sections, files=_files(table, where, folder), where=where)
+    return CarFile(vehicle=vehicle, sections=sections, files=_files(table, where, folder), where=where,
+                   stiffness_scale=stiffness_scale)

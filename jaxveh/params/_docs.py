@@ -47,7 +47,10 @@ units and checks) plus the sections below, the car's data beyond the thesis's ta
 the chassis frame file: a shipped name (`fsae_20x7_13.tir`, `fsae_2009_frame.toml`) or a
 path, relative paths resolved against the car file's folder; a missing file raises
 `ParameterError` naming the key. Table B.4's `kz`, `cz` and relaxation lengths replace the
-tyre file's. The right corners mirror the left; the springs' free lengths are not data: they
+tyre file's. `[chassis]` may also hold `stiffness_scale = [µ1, µ2, ...]`: each chassis
+mode's stiffness multiplier (1 to 20 numbers > 0, mode 1 first; modes beyond the list keep
+1, entries beyond the car's mode count are not used), as `jaxveh optimise` writes an
+optimum's µ. The right corners mirror the left; the springs' free lengths are not data: they
 are set so that the car rests at the design position (`rest_spring_preloads`).
 
 """

@@ -410,6 +410,16 @@ def _springs(file: CarFile, rest_lengths, preloads):
     return jax.tree.map(lambda *x: jnp.stack(x), *laws)
 
 
+def _with_file_stiffness_scale(chassis, scale: tuple):
+    """``chassis`` with the car file's per-mode stiffness multipliers µ (modes beyond the
+    list keep 1; entries beyond the chassis's modes are not used)."""
+    if not scale:
+        return chassis
+    n = min(len(scale), chassis.stiffness_scale.shape[0])
+    return eqx.tree_at(lambda c: c.stiffness_scale, chassis,
+                       chassis.stiffness_scale.at[:n].set(jnp.asarray(scale[:n])))
+
+
 def load_car(path: str | Path | None = None, modes: int = 6, form: str = "fast") -> Car:
     """The car from a car file (default: the shipped ``car.toml``) with ``modes`` chassis
     modes (0 = rigid chassis, up to 20). ``form``: what manoeuvres integrate by default,
@@ -419,6 +429,8 @@ def load_car(path: str | Path | None = None, modes: int = 6, form: str = "fast")
 
     The springs' free lengths are set so that the car at rest on a flat road has every
     suspension at its design position (Tables B.2/B.3), see :func:`rest_spring_preloads`.
+    The file's optional ``[chassis] stiffness_scale`` sets the modes' stiffness multipliers
+    µ (mode 1 first; modes beyond the list keep 1, entries beyond ``modes`` are unused).
     """
     form = check_form(form)
     modes = _check_modes(modes)
@@ -428,6 +440,7 @@ def load_car(path: str | Path | None = None, modes: int = 6, form: str = "fast")
     if modes:
         zeta = file.sections["chassis"]["damping_ratio"]
         chassis = fe.frame_modal_body(_frame(file.files["frame"], file.where), modes, damping_ratio=zeta)
+        chassis = _with_file_stiffness_scale(chassis, file.stiffness_scale)
     tyres = stack_tyres([
         _tyre(file.files["tyre_front" if c.startswith("front") else "tyre_rear"],
               "tyre_front" if c.startswith("front") else "tyre_rear", file.where, v) for c in CORNERS])
