@@ -23,6 +23,8 @@ from ._objectives import (
     Objective as Objective,
     ObjectiveSpec as ObjectiveSpec,
     arb_rates_for_lambda as arb_rates_for_lambda,
+    bump_steer as bump_steer,
+    camber_gain as camber_gain,
     camber_gradient as camber_gradient,
     chassis_mass as chassis_mass,
     chi as chi,
@@ -43,6 +45,7 @@ from ._objectives import (
     step_steer_peak_time as step_steer_peak_time,
     step_steer_response_time as step_steer_response_time,
     step_steer_steady_yaw_rate as step_steer_steady_yaw_rate,
+    suspension_kinematics as suspension_kinematics,
     torsional_stiffness as torsional_stiffness,
     understeer_gradient as understeer_gradient,
 )

@@ -23,6 +23,9 @@ Each objective wraps what jaxveh computes; none re-derives the physics:
   linearisation (:mod:`optimise._response`);
 - the yaw-rate response of a step steer of any size from the fast car's time run
   (:mod:`optimise._step_steer`; ``step_steer_*``);
+- bump steer and camber gain from each corner's kinematics at the design pose
+  (:func:`suspension_kinematics`: the fast car's exact corner solve, differentiated along the
+  wheel travel);
 - the chassis frame's mass and torsional stiffness (FE, :mod:`jaxveh.fe`): functions of a
   :class:`jaxveh.fe.Frame` (:data:`FRAME_OBJECTIVES`), not of ``CarParams``, whose chassis is
   the frame's modal reduction.
@@ -46,14 +49,16 @@ from jaxveh import GRAVITY, ParameterError
 from jaxveh.analysis import (
     LOW_AY_PAIR_G,
     SKID_PAD_RADIUS,
+    WHEEL_PARAMETERS,
     first_chassis_mode,
     linear_field,
     linearise,
     load_transfer_core,
     root_locus,
+    wheel_parameters,
 )
 from jaxveh.manoeuvre import skid_pad_core, straight_trim
-from jaxveh.vehicle import CORNERS, car_rates, installation_ratios
+from jaxveh.vehicle import CORNERS, car_rates, corner_poses, fast_model, installation_ratios
 
 from ._response import (
     linear_io,
@@ -229,6 +234,79 @@ def rear_steer_gradient(car, corner="rear_left", ay_g=DEFAULT_AY_G, radius=SKID_
     (in a turn the outer wheel's travel, and so its roll steer, is the larger: the car
     also heaves)."""
     return _rear_steer_gradient(skid_pad_point(car, ay_g, radius), corner)
+
+
+#: The axles a kinematic objective's ``corner`` may name (the mean of both wheels).
+AXLES = {"front": (0, 1), "rear": (2, 3)}
+
+
+def suspension_kinematics(car):
+    """Each corner's wheel parameters (:data:`jaxveh.analysis.WHEEL_PARAMETERS`) differentiated
+    with respect to its own wheel travel (4, 6; per m of travel: m/m, rad/m) at the design
+    pose: travels 0, rack centred, chassis undeformed (the fast car's exact corner solve)."""
+    model = fast_model(car)
+    modes, rack = jnp.zeros(car.n_modes), jnp.zeros(())
+
+    def parameters(travel):
+        return wheel_parameters(corner_poses(model.geometry, model.kmap, travel, rack, modes), travel,
+                                model.geometry.centre)
+
+    jac = jax.jacfwd(parameters)(jnp.zeros(len(CORNERS)))  # (corner, parameter, travel)
+    return jnp.stack([jac[k, :, k] for k in range(len(CORNERS))])
+
+
+def _corner_rows(corner: str) -> tuple:
+    if corner in AXLES:
+        return AXLES[corner]
+    if corner not in CORNERS:
+        raise ParameterError(f"corner = {corner!r} is not allowed: one of {', '.join(CORNERS)}, front or rear (the "
+                             "axle's mean)")
+    return (CORNERS.index(corner),)
+
+
+#: Each corner's sign that turns the inclination angle γ into camber positive with the top of
+#: the wheel outwards (left wheels: -γ; right wheels: γ).
+_TOP_OUTWARD = np.asarray([-1.0, 1.0, -1.0, 1.0])
+
+
+def _per_travel_deg(rates, corner, parameter, signs=None):
+    rows = np.asarray(_corner_rows(corner))
+    values = rates[rows, WHEEL_PARAMETERS.index(parameter)] * (1.0 if signs is None else signs[rows])
+    return jnp.degrees(jnp.mean(values))
+
+
+def _bump_steer(rates, corner="front_left"):
+    return _per_travel_deg(rates, corner, "toe")
+
+
+def _camber_gain(rates, corner="front_left"):
+    return _per_travel_deg(rates, corner, "camber", _TOP_OUTWARD)
+
+
+def allowed_corners(name: str) -> tuple:
+    """The values the ``corner`` setting of the objective ``name`` allows."""
+    if name == "rear_steer_gradient":
+        return tuple(c for c in CORNERS if c.startswith("rear")) + (REAR_AXLE,)
+    if OBJECTIVES[name].source == "kinematics":
+        return CORNERS + tuple(AXLES)
+    return CORNERS
+
+
+def bump_steer(car, corner="front_left"):
+    """Bump steer (deg/m): the toe-in change of the wheel ``corner`` (a name of
+    :data:`jaxveh.vehicle.CORNERS`, or ``front``/``rear``: the axle's mean) per metre of its
+    own wheel travel (positive in bump) at the design pose, the rack centred and the chassis
+    undeformed; positive: the wheel toes in as it rises."""
+    return _bump_steer(suspension_kinematics(car), corner)
+
+
+def camber_gain(car, corner="front_left"):
+    """Camber gain (deg/m): the camber change of the wheel ``corner`` (or ``front``/``rear``:
+    the axle's mean) per metre of its own wheel travel at the design pose, the rack centred
+    and the chassis undeformed, camber positive with the top of the wheel outwards (SAE;
+    the left wheels' ``camber`` channel, the tyre's inclination γ, has the other sign), so a
+    negative gain: the top leans inwards as the wheel rises."""
+    return _camber_gain(suspension_kinematics(car), corner)
 
 
 def _chi(lt):
@@ -498,6 +576,7 @@ SOURCES = {
     "preview": Source(preview_length, {"speed_kmh": PREVIEW_SPEED_KMH, "n_preview": N_PREVIEW}),
     "step_steer": Source(step_steer_metrics, STEP_STEER_SETTINGS, time_run=True),
     "skid_pad": Source(skid_pad_point, {"ay_g": DEFAULT_AY_G, "radius": SKID_PAD_RADIUS}),
+    "kinematics": Source(suspension_kinematics, {}),
     "load_transfer": Source(load_transfer_point, {"ay_g": tuple(LOW_AY_PAIR_G), "radius": SKID_PAD_RADIUS}),
     "linear": Source(lambda car, speed_kmh, reference: _mode(car, reference, speed_kmh),
                      {"speed_kmh": DEFAULT_SPEED_KMH}, _prepare_reference),
@@ -543,6 +622,13 @@ OBJECTIVES = {
     "rear_steer_gradient": Objective(rear_steer_gradient, "deg/g", "road-wheel angle change per g of a rear "
                                      "wheel (corner; rear: the axle's mean) at ay_g", "skid_pad", _rear_steer_gradient,
                                      {"corner": "rear_left"}),
+    "bump_steer": Objective(bump_steer, "deg/m", "toe-in change per m of the wheel's own travel (corner; front, "
+                            "rear: the axle's mean) at the design pose", "kinematics", _bump_steer,
+                            {"corner": "front_left"}),
+    "camber_gain": Objective(camber_gain, "deg/m", "camber change (top outwards positive) per m of the wheel's "
+                             "own travel (corner; front, rear: the axle's mean) at the design pose", "kinematics",
+                             _camber_gain,
+                             {"corner": "front_left"}),
     "chi": Objective(chi, "1", "front share of the lateral load transfer at low ay, between the two ay_g",
                      "load_transfer", _chi),
     "first_mode_frequency": Objective(first_mode_frequency, "Hz", "damped frequency of the first coupled chassis "

@@ -85,7 +85,6 @@ import scipy.special
 
 from jaxveh import ParameterError, run_time_checks_off, vehicle
 from jaxveh.params import set_all
-from jaxveh.vehicle import CORNERS
 
 from ._car_file import changed_car_values, optimum_car_file
 from ._frame_design import (
@@ -102,8 +101,8 @@ from ._objectives import (
     FRAME_OBJECTIVES,
     FRAME_SOURCE,
     OBJECTIVES,
-    REAR_AXLE,
     ObjectiveSpec,
+    allowed_corners,
     arb_rates_for_lambda,
     follow_mode,
     objective_spec,
@@ -381,8 +380,7 @@ def _spec(where: str, key: str, table: dict, reserved, frame: bool = False) -> O
                     f"{len(default)} increasing numbers > 0" if isinstance(default, tuple) else "a number > 0")
             raise _err(where, f"{key}.{k}", f"= {v!r} is not allowed: {what} (default {default!r})")
     if "corner" in settings:
-        corners = [c for c in CORNERS if name != "rear_steer_gradient" or c.startswith("rear")]
-        corners += [REAR_AXLE] if name == "rear_steer_gradient" else []
+        corners = allowed_corners(name)
         if settings["corner"] not in corners:
             raise _err(where, f"{key}.corner", f"= {settings['corner']!r} is not allowed: one of {', '.join(corners)}")
     spec = objective_spec(name, {k: float(v) if _is_number(v) else v for k, v in settings.items()})
