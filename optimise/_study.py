@@ -12,9 +12,13 @@ A study file::
     vehicle = "my_car.toml"           # optional: car file (model "car") or Appendix A file
                                       # ("analytic"), relative to the study file; default: shipped
     modes = 6                         # chassis modes of the car (0-20; model "car" only)
-    quantities = ["chi"]              # see QUANTITIES
+    quantities = ["chi"]              # see QUANTITIES; model "car": also any objective of
+                                      # optimise.OBJECTIVES (understeer_gradient, bump_steer, ...)
     ay_g = [0.05, 0.1]                # model "car": lateral accelerations (g), χ between the first two
-    radius = 50.0                     # model "car": skid-pad radius (m)
+    radius = 50.0                     # model "car": skid-pad radius (m), of χ
+
+    [settings.understeer_gradient]    # model "car": an objective quantity's settings (default:
+    ay_g = 0.3                        # the objective's own, OBJECTIVES[name].settings)
 
     [[variables]]                     # one table per grid axis, outermost first
     path = "lambda"                   # a path into the parameter pytree, or a label (LABELS)
@@ -48,6 +52,8 @@ from jaxveh import ParameterError
 from jaxveh.analysis import LOW_AY_PAIR_G, SKID_PAD_RADIUS
 from jaxveh.params import parse_path
 
+from ._objectives import OBJECTIVES, allowed_corners, objective_spec
+
 #: The models a study can run on.
 MODELS = ("car", "analytic")
 #: Labels that are not paths into the parameter pytree, per model: λ = kF / (kF + kR) (the
@@ -60,6 +66,8 @@ QUANTITIES = {
     "car": {
         "chi": ("1", "front share of the lateral load transfer at low ay, between the first two ay_g "
                 "(jaxveh.analysis.load_transfer_batch(...).chi_low_ay)"),
+        **{name: (o.units, o.description + " (optimise.OBJECTIVES)") for name, o in OBJECTIVES.items()
+           if name != "chi"},
     },
     "analytic": {
         "chi": ("1", "front share of the lateral load transfer with a torsional chassis, eq. (3.6)"),
@@ -82,6 +90,7 @@ DEFAULT_CHUNK = {"car": 16, "analytic": 256}
 
 _KEYS = {
     "study": ("name", "description", "model", "vehicle", "modes", "quantities", "ay_g", "radius"),
+    "settings": (),
     "variables": ("path", "name", "units", "values", "start", "stop", "num", "log"),
     "run": ("backend", "chunk", "out", "address", "num_cpus"),
 }
@@ -103,7 +112,9 @@ class SweepVariable(NamedTuple):
 
 class Study(NamedTuple):
     """A loaded study file (module docs). ``file`` is the study file's path (``None`` when
-    built in Python), used in error messages and to resolve ``vehicle``."""
+    built in Python), used in error messages and to resolve ``vehicle``. ``settings``: the
+    car's objective quantities' settings beyond their defaults, ``((name, ((key, value),
+    ...)), ...)`` (:func:`quantity_specs`)."""
 
     name: str
     model: str
@@ -120,6 +131,7 @@ class Study(NamedTuple):
     num_cpus: Optional[int] = None
     description: str = ""
     file: Optional[str] = None
+    settings: tuple = ()
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -241,6 +253,50 @@ def _variable(where: str, i: int, table, model: str) -> SweepVariable:
     return SweepVariable(name=name, path=path, values=values, units=units, log=bool(table.get("log", False)))
 
 
+def objective_quantities(study: Study) -> tuple[str, ...]:
+    """The study's quantities that are objectives of the car (all but ``chi``)."""
+    return tuple(q for q in study.quantities if study.model == "car" and q != "chi")
+
+
+def quantity_specs(study: Study) -> tuple:
+    """The :class:`optimise.ObjectiveSpec` of each objective quantity (its settings over
+    the objective's defaults)."""
+    given = dict(study.settings)
+    return tuple(objective_spec(q, dict(given.get(q, ()))) for q in objective_quantities(study))
+
+
+def _check_settings(where: str, study: Study) -> None:
+    for name, settings in study.settings:
+        key = f"settings.{name}"
+        if name not in objective_quantities(study):
+            raise _err(where, key, f"is not allowed: settings of the car's objective quantities of "
+                       f"study.quantities only ({', '.join(objective_quantities(study)) or 'none'})")
+        allowed = OBJECTIVES[name].settings
+        for k, v in settings:
+            if k not in allowed:
+                raise _err(where, f"{key}.{k}", f"is not a key of objective {name!r}: allowed "
+                           f"{', '.join(allowed) or 'none'}")
+            default = allowed[k]
+            if isinstance(default, str):
+                ok = isinstance(v, str) and (k != "corner" or v in allowed_corners(name))
+                what = (f"one of {', '.join(allowed_corners(name))}" if k == "corner" else "a string")
+            elif isinstance(default, tuple):
+                ok = isinstance(v, tuple) and len(v) == len(default) and all(_is_number(x) and x > 0 for x in v)
+                what = f"{len(default)} numbers > 0"
+            else:
+                ok = _is_number(v) and v > 0
+                what = "a number > 0"
+            if not ok:
+                raise _err(where, f"{key}.{k}", f"= {v!r} is not allowed: {what} (default {default!r})")
+
+
+def _settings_tables(where: str, table) -> tuple:
+    if not isinstance(table, dict) or not all(isinstance(t, dict) for t in table.values()):
+        raise _err(where, "settings", "is not allowed: [settings.NAME] tables, one per objective quantity")
+    return tuple(sorted((name, tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in t.items())))
+                        for name, t in table.items()))
+
+
 def _positive_int(where: str, key: str, value, low: int, high: int) -> int:
     if not _is_int(value) or not low <= value <= high:
         raise _err(where, key, f"= {value!r} is not allowed: an integer from {low} to {high}")
@@ -294,6 +350,7 @@ def check_study(study: Study) -> Study:
             raise _err(where, "study.radius", f"= {study.radius!r} is not allowed: a radius > 0 (m)")
     if not isinstance(study.name, str) or not re.match(r"^[A-Za-z0-9_.-]+$", study.name):
         raise _err(where, "study.name", f"= {study.name!r} is not allowed: letters, digits, '_', '.', '-'")
+    _check_settings(where, study)
     return study
 
 
@@ -373,6 +430,7 @@ def load_study(path, *, backend=None, address=None, out=None, chunk=None, num_cp
         num_cpus=num_cpus if num_cpus is not None else run_t.get("num_cpus"),
         description=description,
         file=where,
+        settings=_settings_tables(where, data.get("settings", {})),
     )
     if not isinstance(study.out, str) or not study.out:
         raise _err(where, "run.out", f"= {study.out!r} is not allowed: a folder path")

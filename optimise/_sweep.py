@@ -44,7 +44,8 @@ import jaxveh.analytic as analytic
 from jaxveh import ParameterError, analysis, vehicle
 from jaxveh.params import check_analytic_vehicle, get_at, load_analytic_vehicle, set_all, set_at
 
-from ._study import CONVERGED, LABELS, QUANTITIES, Study, check_study
+from ._objectives import objective_values, prepare
+from ._study import CONVERGED, LABELS, QUANTITIES, Study, check_study, quantity_specs
 
 #: File of the chunk manifest inside ``OUT/chunks``.
 MANIFEST = "manifest.json"
@@ -85,6 +86,7 @@ def grid_hash(study: Study) -> str:
         "quantities": list(study.quantities),
         "ay_g": [float(a).hex() for a in study.ay_g] if study.model == "car" else None,
         "radius": float(study.radius).hex() if study.model == "car" else None,
+        "settings": [[name, [[k, repr(v)] for k, v in items]] for name, items in study.settings],
     }
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()
 
@@ -238,12 +240,22 @@ def car_designs(car, study: Study, points: np.ndarray, memo: Optional[dict] = No
     return eqx.tree_at(lambda p: p.arb_rates, stacked, jnp.asarray(rates))
 
 
+def _objectives_batch(car, designs, specs, prepared):
+    """The objectives ``specs`` of the car with each of the stacked ``designs``."""
+    return jax.vmap(lambda p: objective_values(eqx.tree_at(lambda c: c.params, car, p), specs, prepared))(designs)
+
+
+_compiled_objectives = eqx.filter_jit(_objectives_batch)
+
+
 def _car_model(study: Study) -> Model:
     car = vehicle.load_car(study.vehicle, modes=study.modes)
     paths, _ = _split(study)
     check = lambda params: vehicle.check_car(eqx.tree_at(lambda c: c.params, car, params))
     for i, _ in paths:
         _check_path(study, i, car.params, check)
+    specs = quantity_specs(study)
+    prepared = prepare(car, specs)
 
     memo = {}  # anti-roll-bar rates by (other values, λ): one call per distinct other values
 
@@ -252,9 +264,18 @@ def _car_model(study: Study) -> Model:
         n = points.shape[0]
         size = _batch_size(n)
         designs = _shard(car_designs(car, study, _pad(points, size), memo), size)
-        lt = analysis.load_transfer_batch(car, designs, study.ay_g, study.radius)
-        out = {"chi": np.asarray(lt.chi_low_ay)[:n]}
-        out[CONVERGED] = np.asarray(jnp.all(lt.ok, axis=-1)).astype(np.int8)[:n]
+        out, ok = {}, np.ones(n, dtype=bool)
+        if "chi" in study.quantities:
+            lt = analysis.load_transfer_batch(car, designs, study.ay_g, study.radius)
+            out["chi"] = np.asarray(lt.chi_low_ay)[:n]
+            ok &= np.asarray(jnp.all(lt.ok, axis=-1))[:n]
+        if specs:
+            with jaxveh.run_time_checks_off():  # the designs were checked by car_designs' callers
+                values = np.asarray(_compiled_objectives(car, designs, specs, prepared))[:n]
+            for j, spec in enumerate(specs):
+                out[spec.name] = values[:, j]
+            ok &= np.all(np.isfinite(values), axis=1)
+        out[CONVERGED] = ok.astype(np.int8)
         return out
 
     return Model(base=car, evaluate=evaluate)

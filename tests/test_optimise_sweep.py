@@ -19,8 +19,9 @@ from typer.testing import CliRunner
 
 import jaxveh.analytic as analytic
 import optimise
-from jaxveh import ParameterError, analysis
+from jaxveh import GRAVITY, ParameterError, analysis, vehicle
 from jaxveh.cli import app
+from jaxveh.manoeuvre import skid_pad
 from jaxveh.params import load_analytic_vehicle, set_at
 
 #: vmapped chapter-3 formulas against the same formulas on one point: the batched program
@@ -96,6 +97,22 @@ def _variant(old: str, new: str) -> str:
     return ANALYTIC.replace(old, new)
 
 
+CAR_OBJECTIVES = """
+[study]
+model = "car"
+modes = 0
+quantities = ["bump_steer", "camber_gain"]
+[[variables]]
+path = "vehicle.hard_points_front.points[7, 2]"
+name = "front_L_z"
+units = "m"
+values = [0.305, 0.315, 0.325]
+[settings.bump_steer]
+corner = "front"
+[run]
+chunk = 2
+"""
+
 BAD = [
     ("unknown key", _variant('model = "analytic"', 'model = "analytic"\ncolour = "red"'),
      r"s\.toml: study\.colour is not a known key: allowed keys of \[study\] are name, description"),
@@ -110,9 +127,19 @@ BAD = [
     ("unknown quantity", _variant('"chi_error"', '"chii"'),
      r"s\.toml: study\.quantities has the unknown quantity 'chii': allowed for model = 'analytic': chi, "
      r"chi_rigid, chi_error, understeer_gradient, understeer_gradient_rigid"),
-    ("car quantity on chapter 3", _variant("[run]", "[run]").replace('model = "analytic"', 'model = "car"')
-     .replace('path = "mu"', 'path = "chassis.stiffness_scale[0]"').replace('"chi_error", ', ""),
-     r"study\.quantities has the unknown quantity 'understeer_gradient': allowed for model = 'car': chi"),
+    ("chapter-3 quantity on the car", _variant("[run]", "[run]").replace('model = "analytic"', 'model = "car"')
+     .replace('path = "mu"', 'path = "chassis.stiffness_scale[0]"').replace('"chi_error", "understeer_gradient"',
+                                                                             '"chi_rigid"'),
+     r"study\.quantities has the unknown quantity 'chi_rigid': allowed for model = 'car': chi, understeer_gradient"),
+    ("settings of a quantity not swept", CAR_OBJECTIVES.replace("corner = \"front\"", "corner = \"front\"\n"
+                                                                "[settings.roll_gradient]\nay_g = 0.2"),
+     r"s\.toml: settings\.roll_gradient is not allowed: settings of the car's objective quantities of "
+     r"study\.quantities only \(bump_steer, camber_gain\)"),
+    ("unknown setting", CAR_OBJECTIVES.replace('corner = "front"', 'corner = "front"\nspeed_kmh = 3.0'),
+     r"s\.toml: settings\.bump_steer\.speed_kmh is not a key of objective 'bump_steer': allowed corner"),
+    ("bad corner", CAR_OBJECTIVES.replace('corner = "front"', 'corner = "middle"'),
+     r"s\.toml: settings\.bump_steer\.corner = 'middle' is not allowed: one of front_left, front_right, "
+     r"rear_left, rear_right, front, rear"),
     ("unknown backend", _variant("chunk = 5", 'chunk = 5\nbackend = "spark"'),
      r"s\.toml: run\.backend = 'spark' is not allowed: one of local, ray"),
     ("chunk", _variant("chunk = 5", "chunk = 0"), r"s\.toml: run\.chunk = 0 is not allowed: an integer from 1"),
@@ -409,3 +436,48 @@ def test_car_chi_map_equals_analysis(tmp_path):
     np.testing.assert_allclose(ds.chi.values[:, 1], direct, rtol=CAR_RTOL)
     assert abs(float(ds.chi.values[0, 1] - ds.chi.values[0, 0])) > 1e-5  # the multiplier is applied
     assert [p.name for p in result.plots] == ["car_map_chi.png"]
+
+
+def test_car_objective_quantities_equal_the_objectives(tmp_path):
+    """Objectives of the car as sweep quantities (bump steer of the front axle, camber gain
+    of the front-left wheel with its default corner) over the front track-rod inner joint's
+    height, chunks of 2 (one padded): each point equals the objective evaluated on its own
+    car (1e-12), converged everywhere, units from the objective library."""
+    study = optimise.load_study(write(tmp_path, CAR_OBJECTIVES), out=tmp_path / "out")
+    ds = optimise.sweep(study).dataset
+    car = optimise.build_model(study).base
+    np.testing.assert_array_equal(ds.converged.values, 1)
+    assert ds.bump_steer.attrs["units"] == "deg/m" and ds.bump_steer.dims == ("front_L_z",)
+    for k, z in enumerate((0.305, 0.315, 0.325)):
+        c = vehicle.with_params(car, {"vehicle.hard_points_front.points[7, 2]": z})
+        assert float(ds.bump_steer.values[k]) == pytest.approx(float(optimise.bump_steer(c, "front")), rel=1e-12)
+        assert float(ds.camber_gain.values[k]) == pytest.approx(float(optimise.camber_gain(c)), rel=1e-12)
+    assert ds.bump_steer.values[2] > ds.bump_steer.values[0]  # raising the inner joint: less toe-out in bump
+
+
+@pytest.mark.slow
+def test_car_understeer_gradient_map_equals_the_skid_pad(tmp_path):
+    """The understeer gradient at 0.1 g (``[settings.understeer_gradient]``) beside χ over λ
+    on the rigid car equals jaxveh.manoeuvre.skid_pad's at the same λ (1e-9)."""
+    study = optimise.load_study(write(tmp_path, """
+        [study]
+        model = "car"
+        modes = 0
+        quantities = ["chi", "understeer_gradient"]
+        [[variables]]
+        path = "lambda"
+        values = [0.45, 0.55]
+        [settings.understeer_gradient]
+        ay_g = 0.1
+        [run]
+        chunk = 2
+        """), out=tmp_path / "out")
+    ds = optimise.sweep(study).dataset
+    car = optimise.build_model(study).base
+    np.testing.assert_array_equal(ds.converged.values, 1)
+    for k, lam in enumerate((0.45, 0.55)):
+        rates = np.asarray(analysis.arb_rates_for_distribution(car, lam))
+        c = vehicle.with_params(car, {"arb_rates[0]": float(rates[0]), "arb_rates[1]": float(rates[1])})
+        ku = float(skid_pad(c, 50.0, [0.1 * GRAVITY]).understeer_gradient[0])
+        assert float(ds.understeer_gradient.values[k]) == pytest.approx(ku, rel=1e-9)
+    np.testing.assert_allclose(ds.chi.values, analysis.chi_vs_lambda(car, [0.45, 0.55]), rtol=CAR_RTOL)
