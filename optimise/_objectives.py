@@ -739,14 +739,17 @@ def prepare(car, specs) -> dict:
     return out
 
 
-def objective_values(car, specs, prepared=None, frame=None, reverse=False):
+def objective_values(car, specs, prepared=None, frame=None, reverse=False, overrides=None):
     """The values of the objectives ``specs`` (a tuple of :class:`ObjectiveSpec`) of ``car``
     as one array (their units, :func:`objective_units`), each shared computation done once;
     ``prepared``: :func:`prepare`'s arrays; ``frame``: the chassis frame, for the frame's
     objectives (:data:`FRAME_OBJECTIVES`). Pure and differentiable; NaN where a steady
     state, trim or time run failed. The time runs (``step_steer_*``) differentiate in forward
-    mode (``jax.jacfwd``, what studies use) or, with ``reverse``, in reverse mode (``jax.grad``)."""
+    mode (``jax.jacfwd``, what studies use) or, with ``reverse``, in reverse mode (``jax.grad``).
+    ``overrides``: settings given as (traced) values to every computation that has them,
+    e.g. ``{"speed_kmh": v}`` for a sweep over speed (one program for every speed)."""
     prepared = {} if prepared is None else prepared
+    overrides = {} if overrides is None else overrides
     data = {}
     for spec in specs:
         key = spec.source_key
@@ -757,7 +760,9 @@ def objective_values(car, specs, prepared=None, frame=None, reverse=False):
         elif key not in data:
             source = SOURCES[key[0]]
             extra = {"reverse": reverse} if source.time_run else {}
-            data[key] = source.compute(car, **dict(key[1]), **prepared.get(key, {}), **extra)
+            settings = dict(key[1])
+            settings |= {k: v for k, v in overrides.items() if k in settings}
+            data[key] = source.compute(car, **settings, **prepared.get(key, {}), **extra)
 
     def value(s):
         if s.source_key[0] == FRAME_SOURCE:

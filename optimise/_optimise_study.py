@@ -84,7 +84,6 @@ import scipy.optimize
 import scipy.special
 
 from jaxveh import ParameterError, run_time_checks_off, vehicle
-from jaxveh.params import set_all
 
 from ._car_file import changed_car_values, optimum_car_file
 from ._frame_design import (
@@ -636,7 +635,7 @@ class _DesignApply:
 
     def __call__(self, base, values):
         car, coefficients = base[:2]
-        params = set_all(car.params, {p: values[n] for n, p in self.paths})
+        params = vehicle.set_car_params(car.params, {p: values[n] for n, p in self.paths})
         if self.lam is not None:
             rates = arb_rates_for_lambda(coefficients, values[self.lam])
             params = eqx.tree_at(lambda p: p.arb_rates, params, rates)

@@ -61,6 +61,12 @@ MODELS = ("car", "analytic")
 #: chapter-3 model: ``jaxveh.analytic.with_distribution``) and, chapter 3 only,
 #: µ = kC / (kF + kR).
 LABELS = {"car": ("lambda",), "analytic": ("lambda", "mu")}
+#: The labels of sweep studies: those of :data:`LABELS` and, on the car, the speed
+#: ``speed_kmh`` (km/h) of every objective quantity with a ``speed_kmh`` setting (a traced
+#: value: one compiled program for every speed of the grid).
+SWEEP_LABELS = {"car": ("lambda", "speed_kmh"), "analytic": ("lambda", "mu")}
+#: The range of a swept speed (km/h).
+SPEED_RANGE_KMH = (1.0, 360.0)
 #: Quantities per model: name -> (units, description).
 QUANTITIES = {
     "car": {
@@ -216,6 +222,9 @@ def grid_values(where: str, key: str, table: dict) -> tuple[float, ...]:
 
 def _label_range(where: str, key: str, label: str, values) -> None:
     lo, hi = min(values), max(values)
+    if label == "speed_kmh" and not (SPEED_RANGE_KMH[0] <= lo and hi <= SPEED_RANGE_KMH[1]):
+        raise _err(where, key, f"has speed_kmh values {lo!r} to {hi!r}: allowed {SPEED_RANGE_KMH[0]:g} to "
+                   f"{SPEED_RANGE_KMH[1]:g} km/h")
     if label == "lambda" and not (0.0 < lo and hi < 1.0):
         raise _err(where, key, f"has lambda values {lo!r} to {hi!r}: allowed 0 < lambda < 1 "
                    "(roll stiffness distribution kF / (kF + kR))")
@@ -223,7 +232,7 @@ def _label_range(where: str, key: str, label: str, values) -> None:
         raise _err(where, key, f"has mu values from {lo!r}: allowed mu > 0 (kC / (kF + kR))")
 
 
-def _variable(where: str, i: int, table, model: str) -> SweepVariable:
+def _variable(where: str, i: int, table, model: str, labels=LABELS) -> SweepVariable:
     key = f"variables[{i}]"
     if not isinstance(table, dict):
         raise _err(where, key, "is not a table: write [[variables]] tables")
@@ -231,12 +240,12 @@ def _variable(where: str, i: int, table, model: str) -> SweepVariable:
     path = table.get("path")
     if not isinstance(path, str):
         raise _err(where, f"{key}.path", f"= {path!r} is not allowed: a path into the parameter pytree "
-                   f"(e.g. 'chassis.stiffness_scale[0]') or one of the labels {', '.join(LABELS[model])}")
+                   f"(e.g. 'chassis.stiffness_scale[0]') or one of the labels {', '.join(labels[model])}")
     path = path.strip()
-    if path in LABELS["car"] + LABELS["analytic"] and path not in LABELS[model]:
+    if path in labels["car"] + labels["analytic"] and path not in labels[model]:
         raise _err(where, f"{key}.path", f"= {path!r} is a label of another model: labels of model = "
-                   f"{model!r} are {', '.join(LABELS[model])}")
-    if path not in LABELS[model]:
+                   f"{model!r} are {', '.join(labels[model])}")
+    if path not in labels[model]:
         try:
             parse_path(path)
         except ParameterError as e:
@@ -244,11 +253,11 @@ def _variable(where: str, i: int, table, model: str) -> SweepVariable:
     name = table.get("name", _identifier(path))
     if not isinstance(name, str) or not _NAME.match(name):
         raise _err(where, f"{key}.name", f"= {name!r} is not allowed: an identifier (letters, digits, _)")
-    units = table.get("units", "1" if path in LABELS[model] else "SI")
+    units = table.get("units", ("km/h" if path == "speed_kmh" else "1") if path in labels[model] else "SI")
     if not isinstance(units, str):
         raise _err(where, f"{key}.units", f"= {units!r} is not allowed: a string")
     values = grid_values(where, key, table)
-    if path in LABELS[model]:
+    if path in labels[model]:
         _label_range(where, key, path, values)
     return SweepVariable(name=name, path=path, values=values, units=units, log=bool(table.get("log", False)))
 
@@ -263,6 +272,20 @@ def quantity_specs(study: Study) -> tuple:
     the objective's defaults)."""
     given = dict(study.settings)
     return tuple(objective_spec(q, dict(given.get(q, ()))) for q in objective_quantities(study))
+
+
+def _check_speed(where: str, study: Study) -> None:
+    """A swept ``speed_kmh`` needs a quantity with that setting, and no fixed one."""
+    if "speed_kmh" not in [v.path for v in study.variables]:
+        return
+    with_speed = [q for q in objective_quantities(study) if "speed_kmh" in OBJECTIVES[q].settings]
+    if not with_speed:
+        raise _err(where, "variables", "sweep speed_kmh, which no quantity of study.quantities has: allowed with "
+                   "the objectives with a speed_kmh setting (" + ", ".join(
+                       n for n, o in OBJECTIVES.items() if "speed_kmh" in o.settings) + ")")
+    for name, settings in study.settings:
+        if "speed_kmh" in dict(settings):
+            raise _err(where, f"settings.{name}.speed_kmh", "is not allowed: the study sweeps speed_kmh")
 
 
 def _check_settings(where: str, study: Study) -> None:
@@ -351,6 +374,7 @@ def check_study(study: Study) -> Study:
     if not isinstance(study.name, str) or not re.match(r"^[A-Za-z0-9_.-]+$", study.name):
         raise _err(where, "study.name", f"= {study.name!r} is not allowed: letters, digits, '_', '.', '-'")
     _check_settings(where, study)
+    _check_speed(where, study)
     return study
 
 
@@ -392,7 +416,7 @@ def load_study(path, *, backend=None, address=None, out=None, chunk=None, num_cp
     tables = data.get("variables", [])
     if not isinstance(tables, list):
         raise _err(where, "variables", "is not an array of tables: write [[variables]] tables")
-    variables = tuple(_variable(where, i, t, model) for i, t in enumerate(tables))
+    variables = tuple(_variable(where, i, t, model, SWEEP_LABELS) for i, t in enumerate(tables))
     quantities = study_t.get("quantities", ["chi"])
     if isinstance(quantities, str):
         quantities = [quantities]

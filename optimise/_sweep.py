@@ -14,7 +14,7 @@ as Ray tasks (a local ``ray.init`` or a cluster's ``address``); the workers run 
 code, so the Dataset is identical to the local backend's.
 
 Model ``"car"``: the chapter-6 car (:func:`jaxveh.vehicle.load_car`), path variables set on
-its ``CarParams`` (:func:`jaxveh.params.set_all`, vmapped over the chunk), then λ through
+its ``CarParams`` (:func:`jaxveh.vehicle.set_car_params`, vmapped over the chunk), then λ through
 the anti-roll bars (:func:`jaxveh.analysis.arb_rates_for_distribution`, on the car with the
 chunk's other values, so λ is exact for every design), evaluated by
 :func:`jaxveh.analysis.load_transfer_batch`; a data variable ``converged`` (1 where all the
@@ -45,7 +45,7 @@ from jaxveh import ParameterError, analysis, vehicle
 from jaxveh.params import check_analytic_vehicle, get_at, load_analytic_vehicle, set_all, set_at
 
 from ._objectives import objective_values, prepare
-from ._study import CONVERGED, LABELS, QUANTITIES, Study, check_study, quantity_specs
+from ._study import CONVERGED, QUANTITIES, SWEEP_LABELS, Study, check_study, quantity_specs
 
 #: File of the chunk manifest inside ``OUT/chunks``.
 MANIFEST = "manifest.json"
@@ -139,8 +139,8 @@ def _check_path(study: Study, i: int, tree, check: Callable) -> None:
 
 def _split(study: Study):
     """(indices and paths of the path variables, {label: index})."""
-    paths = tuple((i, v.path) for i, v in enumerate(study.variables) if v.path not in LABELS[study.model])
-    labels = {v.path: i for i, v in enumerate(study.variables) if v.path in LABELS[study.model]}
+    paths = tuple((i, v.path) for i, v in enumerate(study.variables) if v.path not in SWEEP_LABELS[study.model])
+    labels = {v.path: i for i, v in enumerate(study.variables) if v.path in SWEEP_LABELS[study.model]}
     return paths, labels
 
 
@@ -214,13 +214,13 @@ def _analytic_model(study: Study) -> Model:
 
 def car_designs(car, study: Study, points: np.ndarray, memo: Optional[dict] = None):
     """Stacked ``CarParams`` of the grid ``points`` (``(n, n_variables)``): the path
-    variables set by one vmapped :func:`jaxveh.params.set_all`, then λ through the anti-roll
+    variables set by one vmapped :func:`jaxveh.vehicle.set_car_params`, then λ through the anti-roll
     bars on the car with each point's other values: one vectorised
     :func:`jaxveh.analysis.arb_rates_for_distribution` call per distinct set of them, for
     every λ of the grid at once, kept in ``memo`` (a dict the caller keeps between chunks)."""
     paths, labels = _split(study)
     pts = jnp.asarray(points, jnp.float64)
-    stacked = eqx.filter_vmap(lambda x: set_all(car.params, {p: x[i] for i, p in paths}))(pts)
+    stacked = eqx.filter_vmap(lambda x: vehicle.set_car_params(car.params, {p: x[i] for i, p in paths}))(pts)
     if "lambda" not in labels:
         return stacked
     memo = {} if memo is None else memo
@@ -240,9 +240,14 @@ def car_designs(car, study: Study, points: np.ndarray, memo: Optional[dict] = No
     return eqx.tree_at(lambda p: p.arb_rates, stacked, jnp.asarray(rates))
 
 
-def _objectives_batch(car, designs, specs, prepared):
-    """The objectives ``specs`` of the car with each of the stacked ``designs``."""
-    return jax.vmap(lambda p: objective_values(eqx.tree_at(lambda c: c.params, car, p), specs, prepared))(designs)
+def _objectives_batch(car, designs, specs, prepared, speeds):
+    """The objectives ``specs`` of the car with each of the stacked ``designs``, at each of
+    ``speeds`` (km/h; ``None``: the specs' own)."""
+    def one(p, speed):
+        overrides = None if speed is None else {"speed_kmh": speed}
+        return objective_values(eqx.tree_at(lambda c: c.params, car, p), specs, prepared, overrides=overrides)
+
+    return jax.vmap(one)(designs, speeds)
 
 
 _compiled_objectives = eqx.filter_jit(_objectives_batch)
@@ -256,6 +261,7 @@ def _car_model(study: Study) -> Model:
         _check_path(study, i, car.params, check)
     specs = quantity_specs(study)
     prepared = prepare(car, specs)
+    speed = _split(study)[1].get("speed_kmh")
 
     memo = {}  # anti-roll-bar rates by (other values, λ): one call per distinct other values
 
@@ -270,8 +276,9 @@ def _car_model(study: Study) -> Model:
             out["chi"] = np.asarray(lt.chi_low_ay)[:n]
             ok &= np.asarray(jnp.all(lt.ok, axis=-1))[:n]
         if specs:
-            with jaxveh.run_time_checks_off():  # the designs were checked by car_designs' callers
-                values = np.asarray(_compiled_objectives(car, designs, specs, prepared))[:n]
+            speeds = None if speed is None else _shard(jnp.asarray(_pad(points, size)[:, speed]), size)
+            with jaxveh.run_time_checks_off():  # every value of each variable was checked on the car
+                values = np.asarray(_compiled_objectives(car, designs, specs, prepared, speeds))[:n]
             for j, spec in enumerate(specs):
                 out[spec.name] = values[:, j]
             ok &= np.all(np.isfinite(values), axis=1)

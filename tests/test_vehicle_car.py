@@ -258,6 +258,21 @@ def test_car_file_stiffness_multipliers(tmp_path):
             vehicle.load_car(path, modes=0)
 
 
+def test_table_b4_tyre_values_reach_the_tyres():
+    """``vehicle.tyre.kz`` (and cz, the relaxation lengths) set through with_params reach all
+    four tyres the car runs on, as the car file's do; a corner's own path is applied after
+    it; the chapter-3 parameters read from the car follow (tyre rate into the ride rate)."""
+    car = vehicle.load_car(modes=0)
+    changed = vehicle.with_params(car, {"vehicle.tyre.kz": 2.0e5, "vehicle.tyre.sigma_kappa": 0.05,
+                                        "tyres.vertical_stiffness[3]": 1.8e5})
+    np.testing.assert_array_equal(changed.params.tyres.vertical_stiffness, [2.0e5, 2.0e5, 2.0e5, 1.8e5])
+    np.testing.assert_array_equal(changed.params.tyres.sigma_kappa, [0.05] * 4)
+    assert float(changed.params.vehicle.tyre.kz) == 2.0e5
+    np.testing.assert_array_equal(changed.params.tyres.vertical_damping, car.params.tyres.vertical_damping)
+    jitted = jax.jit(lambda kz: vehicle.set_car_params(car.params, {"vehicle.tyre.kz": kz}).tyres.vertical_stiffness)
+    np.testing.assert_array_equal(jitted(1.6e5), [1.6e5] * 4)
+
+
 def test_form_is_checked():
     with pytest.raises(ParameterError, match="form = 'quick'.*'fast', 'library'"):
         vehicle.load_car(form="quick", modes=0)

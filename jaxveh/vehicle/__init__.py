@@ -31,6 +31,7 @@ from ._car import (
     design_spring_lengths as design_spring_lengths,
     load_car as load_car,
     rest_spring_preloads as rest_spring_preloads,
+    set_car_params as set_car_params,
     sprung_cg as sprung_cg,
     static_corner_loads as static_corner_loads,
     steering as steering,

@@ -242,12 +242,35 @@ def check_car(car: Car) -> Car:
     return car
 
 
+#: Table B.4's tyre values (``CarParams.vehicle.tyre``) and the fields of the four tyres
+#: (``CarParams.tyres``) the car loads them into; the car runs on the tyres' fields.
+TYRE_TABLE_FIELDS = {"kz": "vertical_stiffness", "cz": "vertical_damping", "sigma_kappa": "sigma_kappa",
+                     "sigma_alpha": "sigma_alpha"}
+
+
+def set_car_params(params: CarParams, values: dict) -> CarParams:
+    """``params`` with the values at the paths of ``values`` set (:func:`jaxveh.params.set_all`;
+    traceable, vmappable). A Table B.4 value ``vehicle.tyre.kz`` (``cz``, ``sigma_kappa``,
+    ``sigma_alpha``) is set on all four tyres too (``tyres.vertical_stiffness``, ...), as
+    :func:`load_car` does from the car file, so it acts on the car; a path into the tyres
+    themselves (``tyres.vertical_stiffness[0]``, one corner) is applied after it."""
+    table = {k: v for k, v in values.items() if k.replace(" ", "").startswith("vehicle.tyre.")}
+    for path, value in table.items():
+        field = TYRE_TABLE_FIELDS.get(path.replace(" ", "")[len("vehicle.tyre."):])
+        if field is not None:
+            tyres = eqx.tree_at(lambda t, f=field: getattr(t, f), params.tyres,
+                                jnp.broadcast_to(jnp.asarray(value, jnp.float64), getattr(params.tyres, field).shape))
+            params = eqx.tree_at(lambda p: p.tyres, params, tyres)
+    return set_all(params, values)
+
+
 def with_params(car: Car, values: dict) -> Car:
     """Copy of ``car`` with the :class:`CarParams` values at the paths of ``values`` set
     (``{"arb_rates[0]": 3e4, "chassis.stiffness_scale[0]": 2.0, "coupling": 0.5}``; paths
-    as :func:`jaxveh.params.set_at`, relative to ``car.params``), then checked
+    as :func:`jaxveh.params.set_at`, relative to ``car.params``; :func:`set_car_params`:
+    a Table B.4 tyre value reaches the four tyres), then checked
     (:func:`check_car`). The structure is unchanged: no recompilation."""
-    params = set_all(car.params, values)
+    params = set_car_params(car.params, values)
     return check_car(eqx.tree_at(lambda c: c.params, car, params))
 
 
