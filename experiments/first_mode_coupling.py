@@ -4,12 +4,15 @@ with their kinetic-energy shares, for the shipped car and for variants that each
 path between the chassis and the wheels' spin: the wheels' spin inertia × 10, the tyres'
 longitudinal relaxation length / 10, and the speed (100 km/h against 50). A mode whose
 frequency moves with them is a wheel-spin / longitudinal-tyre mode the chassis takes part
-in. Writes first_mode_coupling.json (default results/first_mode_coupling)."""
+in. For the shipped car and the heavy wheels also the coupling root locus's first chassis
+mode (followed by MAC from the free-free 39 Hz mode at coupling 0, as Fig. 7.7a), and the
+mode with the largest share of chassis modes 1 and 2 at coupling 1. Writes
+first_mode_coupling.json (default results/first_mode_coupling)."""
 
 import numpy as np
 from _util import output_dir, write_json
 
-from jaxveh.analysis import kinetic_energy_shares, linearise, modes
+from jaxveh.analysis import kinetic_energy_shares, linearise, modes, root_locus_report
 from jaxveh.params import get_at
 from jaxveh.vehicle import load_car, with_params
 
@@ -38,8 +41,15 @@ def _band(car, speed_kmh):
         shares = kinetic_energy_shares(car, vec[:, k])
         top = sorted(shares.items(), key=lambda kv: -kv[1])[:4]
         rows.append({"frequency_hz": float(f), "damping_ratio": float(-lam[k].real / abs(lam[k])),
+                     "natural_frequency_hz": float(abs(lam[k]) / (2.0 * np.pi)),
+                     "chassis_1_2_share": float(shares.get("chassis mode 1", 0.0) + shares.get("chassis mode 2", 0.0)),
                      "energy": {name: round(float(x), 3) for name, x in top}})
     return rows
+
+
+def _tracked(car):
+    """The coupling root locus's first chassis mode at coupling 0 and 1 (Hz, label)."""
+    return root_locus_report(car, "coupling")["first_chassis_mode_hz"]
 
 
 def main():
@@ -47,11 +57,19 @@ def main():
     car = load_car(modes=6)
     report = {}
     for label, (variant, speed) in _variants(car).items():
-        report[label] = _band(variant, speed)
+        rows = _band(variant, speed)
+        report[label] = {"modes": rows}
         print(label)
-        for row in report[label]:
+        for row in rows:
             energy = ", ".join(f"{k} {v:.2f}" for k, v in row["energy"].items())
-            print(f"  {row['frequency_hz']:6.2f} Hz  zeta {row['damping_ratio']:.3f}  {energy}")
+            print(f"  {row['frequency_hz']:6.2f} Hz (natural {row['natural_frequency_hz']:6.2f})  zeta "
+                  f"{row['damping_ratio']:.3f}  {energy}")
+        top = max(rows, key=lambda r: r["chassis_1_2_share"])
+        print(f"  most chassis modes 1+2 ({top['chassis_1_2_share']:.2f}): {top['frequency_hz']:.2f} Hz, zeta "
+              f"{top['damping_ratio']:.3f}")
+        if label in ("shipped, 50 km/h", "wheel spin inertia x 10"):
+            report[label]["tracked_first_chassis_mode"] = tracked = _tracked(variant)
+            print(f"  tracked first chassis mode: {tracked}")
     write_json(report, out / "first_mode_coupling.json")
 
 

@@ -14,6 +14,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import scipy.optimize
 import xarray as xr
 from typer.testing import CliRunner
 
@@ -481,3 +482,35 @@ def test_car_understeer_gradient_map_equals_the_skid_pad(tmp_path):
         ku = float(skid_pad(c, 50.0, [0.1 * GRAVITY]).understeer_gradient[0])
         assert float(ds.understeer_gradient.values[k]) == pytest.approx(ku, rel=1e-9)
     np.testing.assert_allclose(ds.chi.values, analysis.chi_vs_lambda(car, [0.45, 0.55]), rtol=CAR_RTOL)
+
+
+@pytest.mark.slow
+def test_car_speed_sweep_equals_the_transfer_function(tmp_path):
+    """``speed_kmh`` as a sweep variable (a traced speed: one program for both speeds) of
+    the yaw-rate bandwidth on the rigid car equals the -3 dB frequency of
+    jaxveh.analysis.transfer_function at each speed found by SciPy's brentq (1e-8)."""
+    study = optimise.load_study(write(tmp_path, """
+        [study]
+        model = "car"
+        modes = 0
+        quantities = ["yaw_rate_bandwidth"]
+        [[variables]]
+        path = "speed_kmh"
+        values = [50.0, 90.0]
+        [run]
+        chunk = 2
+        """), out=tmp_path / "out")
+    ds = optimise.sweep(study).dataset
+    car = optimise.build_model(study).base
+    np.testing.assert_array_equal(ds.converged.values, 1)
+    assert ds.speed_kmh.attrs["units"] == "km/h"
+    for k, speed in enumerate((50.0, 90.0)):
+        lin = analysis.linearise(car, speed / 3.6, outputs=("yaw_rate",))
+        row = analysis.output_index(lin, "yaw_rate")
+        gain = lambda f, lin=lin, row=row: float(np.abs(analysis.transfer_function(lin, [f], "steering")[0, row]))
+        ratio = lambda f, g0=gain(0.05), gain=gain: gain(f) / g0 - 2.0 ** -0.5
+        grid = np.geomspace(0.05, 20.0, 400)
+        first = next(i for i, f in enumerate(grid) if ratio(f) < 0.0)
+        reference = scipy.optimize.brentq(ratio, grid[first - 1], grid[first], xtol=1e-14)
+        assert float(ds.yaw_rate_bandwidth.values[k]) == pytest.approx(reference, rel=1e-8)
+    assert ds.yaw_rate_bandwidth.values[1] != ds.yaw_rate_bandwidth.values[0]
