@@ -8,6 +8,7 @@ and the changed ones written into a copy of the base file in its units, so that 
 read back gives the optimum's car.
 """
 
+import functools
 import json
 import re
 from importlib import resources
@@ -96,16 +97,18 @@ def file_entries(params) -> dict:
     return out
 
 
-def _base_params(study):
-    """The study's base car's parameters with its file's stiffness multipliers (the modes
-    of the study; the bars, coupling and rack as any mode count)."""
-    return vehicle.load_car(study.vehicle, modes=study.modes).params
+@functools.lru_cache(maxsize=8)
+def _base_entries(vehicle_file, modes: int, mtime_ns) -> dict:
+    """:func:`file_entries` of the base car (its file and mode count; ``mtime_ns``, the
+    file's modification time, keys the cache)."""
+    return file_entries(vehicle.load_car(vehicle_file, modes=modes).params)
 
 
 def changed_entries(result) -> dict:
     """``{path: FileEntry}`` of the car-file values whose text differs between the study's
     base car and the optimum (:func:`file_entries`)."""
-    base = file_entries(_base_params(result.study))
+    study = result.study
+    base = _base_entries(study.vehicle, study.modes, Path(study.vehicle).stat().st_mtime_ns if study.vehicle else 0)
     return {path: e for path, e in file_entries(result.car.params).items()
             if path not in base or base[path].text != e.text}
 

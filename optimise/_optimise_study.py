@@ -875,8 +875,8 @@ def _merit(study, index, ev: _Evaluation, multipliers, rho):
 
 def _infeasibility(study, violations) -> float:
     """The largest constraint violation: an inequality's positive part, an equality's size."""
-    return max((abs(g) if c.is_equality else max(0.0, g) for c, g in zip(study.constraints, violations)),
-               default=0.0)
+    return float(max((abs(g) if c.is_equality else max(0.0, g) for c, g in zip(study.constraints, violations)),
+                     default=0.0))
 
 
 def _update_multipliers(study, multipliers, violations, rho) -> np.ndarray:
@@ -1111,7 +1111,7 @@ def _slsqp(study, index, ev, evaluate, finite, accept, record, result, failure) 
     if not np.array_equal(final.z, current["good"].z):
         log(final)
     worst = _infeasibility(study, _violations(study, index, final)[0])
-    converged = bool(res.success) and worst <= opts["constraint_tol"]
+    converged = bool(res.success and worst <= opts["constraint_tol"])
     message = f"SLSQP: {res.message}" + ("" if worst <= opts["constraint_tol"] else
                                          f" (largest constraint violation {worst:.3g})")
     return result(final, converged, message)

@@ -70,7 +70,7 @@ MODULE_SECONDS = {
     "test_multibody_imex.py": 262,
     "test_manoeuvre_frequency.py": 221,
     "test_vehicle_corner.py": 125,
-    "test_optimise_kinematics.py": 115,
+    "test_optimise_kinematics.py": 200,
     "test_manoeuvre_ramp.py": 120,
     "test_multibody_pendulum.py": 111,
     "test_fe_grad.py": 105,
