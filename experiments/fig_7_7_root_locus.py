@@ -22,7 +22,8 @@ def main():
         report[sweep] = r
         loci = {f"{k + 1}: {m['label']}": (np.asarray(m["real_per_s"]) + 2j * np.pi * np.asarray(m["frequency_hz"]))
                 [:, None] for k, m in enumerate(r["modes"]) if max(m["frequency_hz"]) > 0.0}
-        plot_root_locus(loci, ax=ax, title=f"{sweep} {r['values'][0]:g} -> {r['values'][-1]:g}{'' if r['unit'] == '1' else ' ' + r['unit']} "
+        unit = "" if r["unit"] == "1" else f" {r['unit']}"
+        plot_root_locus(loci, ax=ax, title=f"{sweep} {r['values'][0]:g} -> {r['values'][-1]:g}{unit} "
                         "(square: start, circle: end)")
         ax.legend(fontsize=5, ncol=2)
     save(fig, out / "fig_7_7.png")
