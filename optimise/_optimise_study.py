@@ -101,7 +101,6 @@ from ._objectives import (
     FRAME_SOURCE,
     OBJECTIVES,
     ObjectiveSpec,
-    allowed_corners,
     arb_rates_for_lambda,
     follow_mode,
     objective_spec,
@@ -121,6 +120,7 @@ from ._study import (
     _is_number,
     _positive_int,
     _variable,
+    check_setting,
     check_study,
     read_study_file,
 )
@@ -366,22 +366,7 @@ def _spec(where: str, key: str, table: dict, reserved, frame: bool = False) -> O
         if k not in allowed:
             raise _err(where, f"{key}.{k}", f"is not a key of objective {name!r}: allowed "
                        f"{', '.join(reserved + tuple(allowed))}")
-        default = allowed[k]
-        if isinstance(default, str):
-            ok = isinstance(v, str)
-        elif isinstance(default, tuple):
-            ok = isinstance(v, list) and len(v) == len(default) and all(_is_number(x) and x > 0 for x in v) \
-                and all(b > a for a, b in zip(v, v[1:]))
-        else:
-            ok = _is_number(v) and v > 0
-        if not ok:
-            what = ("a string" if isinstance(default, str) else
-                    f"{len(default)} increasing numbers > 0" if isinstance(default, tuple) else "a number > 0")
-            raise _err(where, f"{key}.{k}", f"= {v!r} is not allowed: {what} (default {default!r})")
-    if "corner" in settings:
-        corners = allowed_corners(name)
-        if settings["corner"] not in corners:
-            raise _err(where, f"{key}.corner", f"= {settings['corner']!r} is not allowed: one of {', '.join(corners)}")
+        check_setting(where, key, name, k, v)
     spec = objective_spec(name, {k: float(v) if _is_number(v) else v for k, v in settings.items()})
     return spec
 

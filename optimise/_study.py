@@ -288,6 +288,28 @@ def _check_speed(where: str, study: Study) -> None:
             raise _err(where, f"settings.{name}.speed_kmh", "is not allowed: the study sweeps speed_kmh")
 
 
+def check_setting(where: str, key: str, name: str, setting: str, value) -> None:
+    """``value`` of the objective ``name``'s ``setting`` (a key it has) is allowed: its
+    ``corner`` one of :func:`optimise.allowed_corners`, a string where the default is one,
+    increasing numbers > 0 where the default is a tuple, a number > 0 otherwise;
+    ``ParameterError`` naming ``key.setting`` otherwise."""
+    default = OBJECTIVES[name].settings[setting]
+    if setting == "corner":
+        if value not in allowed_corners(name):
+            raise _err(where, f"{key}.corner", f"= {value!r} is not allowed: one of {', '.join(allowed_corners(name))}")
+        return
+    if isinstance(default, str):
+        ok, what = isinstance(value, str), "a string"
+    elif isinstance(default, tuple):
+        ok = isinstance(value, (list, tuple)) and len(value) == len(default) and all(
+            _is_number(x) and x > 0 for x in value) and all(b > a for a, b in zip(value, value[1:]))
+        what = f"{len(default)} increasing numbers > 0"
+    else:
+        ok, what = _is_number(value) and value > 0, "a number > 0"
+    if not ok:
+        raise _err(where, f"{key}.{setting}", f"= {value!r} is not allowed: {what} (default {default!r})")
+
+
 def _check_settings(where: str, study: Study) -> None:
     for name, settings in study.settings:
         key = f"settings.{name}"
@@ -299,18 +321,7 @@ def _check_settings(where: str, study: Study) -> None:
             if k not in allowed:
                 raise _err(where, f"{key}.{k}", f"is not a key of objective {name!r}: allowed "
                            f"{', '.join(allowed) or 'none'}")
-            default = allowed[k]
-            if isinstance(default, str):
-                ok = isinstance(v, str) and (k != "corner" or v in allowed_corners(name))
-                what = (f"one of {', '.join(allowed_corners(name))}" if k == "corner" else "a string")
-            elif isinstance(default, tuple):
-                ok = isinstance(v, tuple) and len(v) == len(default) and all(_is_number(x) and x > 0 for x in v)
-                what = f"{len(default)} numbers > 0"
-            else:
-                ok = _is_number(v) and v > 0
-                what = "a number > 0"
-            if not ok:
-                raise _err(where, f"{key}.{k}", f"= {v!r} is not allowed: {what} (default {default!r})")
+            check_setting(where, key, name, k, v)
 
 
 def _settings_tables(where: str, table) -> tuple:
