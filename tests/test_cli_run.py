@@ -41,3 +41,13 @@ def test_report_puts_the_car_beside_the_thesis():
     assert "| roll at 1 g, deg | 2.01 | 2.01 | about 2 |" in report
     assert "| front share of load transfer at 1 g | n/a | n/a |" in report  # beyond the curve
     assert "![skid-pad](car_skid_pad.png)" in report and "30.0, 40.0 Hz" in report
+
+
+def test_help_texts_keep_square_brackets():
+    """Units and study-file keys in square brackets are part of the help (Rich markup would
+    swallow them as tags)."""
+    runner = CliRunner()
+    tyre = runner.invoke(app, ["tyre", "eval", "--help"], terminal_width=200)
+    assert tyre.exit_code == 0 and "Slip angle [deg]" in tyre.output
+    study = runner.invoke(app, ["optimise", "--help"], terminal_width=200)
+    assert study.exit_code == 0 and "[requirement] table" in study.output and "[run] out" in study.output

@@ -9,9 +9,9 @@ import typer
 from ..analytic import _reports as reports
 from ..params import ParameterError, load_analytic_vehicle
 from ..plots import plot_bode, plot_map, plot_preview, plot_root_locus, plot_skidpad, plot_step_steer, save
-from ._common import emit_json, fail, write_json
+from ._common import emit_json, fail, new_app, write_json
 
-app = typer.Typer(help="Chapter-3 analytic models (Appendix A vehicle by default).", no_args_is_help=True)
+app = new_app("Chapter-3 analytic models (Appendix A vehicle by default).")
 
 VehicleOpt = typer.Option(None, "--vehicle", help="Appendix-A-style TOML file (default: shipped appendix_a.toml).")
 LamOpt = typer.Option(

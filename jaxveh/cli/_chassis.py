@@ -6,11 +6,9 @@ import numpy as np
 import typer
 
 from .._core import ParameterError
-from ._common import emit_json, fail
+from ._common import emit_json, fail, new_app
 
-app = typer.Typer(
-    help="Chassis finite-element model: torsion test, free-free modes, Craig-Bampton.", no_args_is_help=True
-)
+app = new_app("Chassis finite-element model: torsion test, free-free modes, Craig-Bampton.")
 
 FrameOpt = typer.Option(None, "--frame", help="frame TOML file (default: the shipped FSAE 2009 frame)")
 JsonOpt = typer.Option(False, "--json", help="print only JSON on stdout")

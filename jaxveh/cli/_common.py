@@ -7,6 +7,12 @@ import numpy as np
 import typer
 
 
+def new_app(help: str, **options) -> typer.Typer:
+    """A Typer (sub-)application whose help texts are printed as written: Rich markup is
+    off, so units and file keys in square brackets (``[deg]``, ``[run] out``) stay visible."""
+    return typer.Typer(help=help, no_args_is_help=True, rich_markup_mode="markdown", **options)
+
+
 def to_jsonable(obj):
     """Convert arrays, NumPy scalars and nested containers to plain Python values."""
     if isinstance(obj, dict):

@@ -1,9 +1,9 @@
 """Top-level ``jaxveh`` Typer application; each sub-command group lives in its own module."""
 
-import typer
 
 from ._analytic import app as analytic_app
 from ._chassis import app as chassis_app
+from ._common import new_app
 from ._multibody import app as multibody_app
 from ._optimise import optimise as optimise_command
 from ._run import run as run_command
@@ -12,11 +12,7 @@ from ._study import sweep as sweep_command
 from ._tyre import app as tyre_app
 from ._vehicle import rig_app, vehicle_app
 
-app = typer.Typer(
-    help="jaxveh: differentiable vehicle dynamics with a flexible chassis.",
-    no_args_is_help=True,
-    add_completion=False,
-)
+app = new_app("jaxveh: differentiable vehicle dynamics with a flexible chassis.", add_completion=False)
 app.command("run")(run_command)
 app.command("optimise")(optimise_command)
 app.command("sweep")(sweep_command)

@@ -2,11 +2,9 @@
 
 import typer
 
-from ._common import emit_json, fail
+from ._common import emit_json, fail, new_app
 
-app = typer.Typer(
-    help="Flexible multibody library (thesis chapter 5): inspect built-in examples.", no_args_is_help=True
-)
+app = new_app("Flexible multibody library (thesis chapter 5): inspect built-in examples.")
 
 _VALUE_OPTIONS = ("--q", "--qdot")
 

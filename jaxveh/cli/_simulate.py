@@ -10,9 +10,9 @@ import numpy as np
 import typer
 
 from .._core import ParameterError
-from ._common import emit_json, fail, write_curve_csv, write_json
+from ._common import emit_json, fail, new_app, write_curve_csv, write_json
 
-app = typer.Typer(help="Manoeuvres of the 14-DOF car with its flexible chassis.", no_args_is_help=True)
+app = new_app("Manoeuvres of the 14-DOF car with its flexible chassis.")
 
 VehicleOpt = typer.Option(None, "--vehicle", help="car TOML file (default: the shipped car.toml)")
 ModesOpt = typer.Option(6, "--modes", help="chassis modes, 0 (rigid) to 20")

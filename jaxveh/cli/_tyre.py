@@ -8,9 +8,9 @@ import numpy as np
 import typer
 
 from ..params import ParameterError
-from ._common import emit_json, fail, write_json
+from ._common import emit_json, fail, new_app, write_json
 
-app = typer.Typer(help="Magic Formula 5.2 tyres: evaluate, plot Fig. B.1 panels, fit .tir files.", no_args_is_help=True)
+app = new_app("Magic Formula 5.2 tyres: evaluate, plot Fig. B.1 panels, fit .tir files.")
 
 TirOpt = typer.Option(None, "--tir", help=".tir property file (default: the shipped FSAE 20.0x7.0-13 tyre).")
 JsonOpt = typer.Option(False, "--json", help="Print a machine-readable JSON result on stdout.")

@@ -7,10 +7,10 @@ import numpy as np
 import typer
 
 from .._core import ParameterError
-from ._common import emit_json, fail, write_json
+from ._common import emit_json, fail, new_app, write_json
 
-vehicle_app = typer.Typer(help="The 14-DOF car with its flexible chassis: summary.", no_args_is_help=True)
-rig_app = typer.Typer(help="Quasi-static kinematic rigs of the car (Figs. 6.11, 6.12).", no_args_is_help=True)
+vehicle_app = new_app("The 14-DOF car with its flexible chassis: summary.")
+rig_app = new_app("Quasi-static kinematic rigs of the car (Figs. 6.11, 6.12).")
 
 VehicleOpt = typer.Option(None, "--vehicle", help="car TOML file (default: the shipped car.toml)")
 ModesOpt = typer.Option(6, "--modes", help="chassis modes, 0 (rigid) to 20")
