@@ -18,32 +18,13 @@ import json
 from pathlib import Path
 
 import numpy as np
-from _util import use_disk_cache
+from _util import jacobian_check, study_values, use_disk_cache
 
 import optimise
 
 STUDY = Path(__file__).with_name("studies") / "hard_points.toml"
 #: Points of the scan over the variable's bounds.
 SCAN_POINTS = 11
-
-
-def _values(design, point: dict) -> dict:
-    values, _ = design.evaluate(np.asarray(design.problem.to_z(point)))
-    return {s.name: float(v) for s, v in zip(design.specs, values)}
-
-
-def _derivative_check(design, point: dict, step: float = 1e-4) -> dict:
-    """The study's forward-mode Jacobian (per unconstrained variable) against central
-    differences of the same compiled values at ``point``: the largest relative error."""
-    z0 = np.asarray(design.problem.to_z(point))
-    _, jac = design.evaluate(z0)
-    fd = np.zeros_like(jac)
-    for k in range(z0.size):
-        dz = np.zeros_like(z0)
-        dz[k] = step
-        fd[:, k] = (design.evaluate(z0 + dz)[0] - design.evaluate(z0 - dz)[0]) / (2.0 * step)
-    return {"jacobian": jac.tolist(), "central_differences": fd.tolist(), "step_z": step,
-            "max_relative_error": float(np.max(np.abs(jac - fd)) / np.max(np.abs(fd)))}
 
 
 def main():
@@ -62,7 +43,7 @@ def main():
     for label, modes in (("flexible", base.modes), ("rigid", 0)):
         study = base._replace(modes=modes, name=f"hard_points_{label}", out=str(args.out / label))
         designs[label] = design = optimise.build_design(study)
-        check = _derivative_check(design, initial)
+        check = jacobian_check(design, initial)
         print(f"{label}: Jacobian vs central differences at the design, largest relative error "
               f"{check['max_relative_error']:.2e}", flush=True)
         result = optimise.optimise_study(study, design=design, progress=lambda e, label=label: print(
@@ -70,13 +51,13 @@ def main():
             f"{var.name} {e[var.name] * 1e3:.4f} mm", flush=True))
         files = optimise.write_outputs(result)
         report[label] = {"modes": modes, "optimum": result.optimum, "values": result.values,
-                         "at_initial": _values(design, initial), "converged": result.converged,
+                         "at_initial": study_values(design, initial), "converged": result.converged,
                          "message": result.message, "iterations": result.iterations,
                          "evaluations": result.evaluations, "wall_s": result.wall_s, "files": files,
                          "derivative_check": check,
-                         "scan": [_values(design, {var.name: float(x)}) for x in scan]}
-    report["flexible_at_rigid_optimum"] = _values(designs["flexible"], report["rigid"]["optimum"])
-    report["rigid_at_flexible_optimum"] = _values(designs["rigid"], report["flexible"]["optimum"])
+                         "scan": [study_values(design, {var.name: float(x)}) for x in scan]}
+    report["flexible_at_rigid_optimum"] = study_values(designs["flexible"], report["rigid"]["optimum"])
+    report["rigid_at_flexible_optimum"] = study_values(designs["rigid"], report["flexible"]["optimum"])
     report["optimum_difference_mm"] = 1e3 * (report["flexible"]["optimum"][var.name]
                                              - report["rigid"]["optimum"][var.name])
     args.out.mkdir(parents=True, exist_ok=True)

@@ -22,28 +22,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from _util import use_disk_cache  # noqa: E402
+from _util import jacobian_check, use_disk_cache  # noqa: E402
 
 import jaxveh.fe as fe  # noqa: E402
 import optimise  # noqa: E402
 
 STUDY = Path(__file__).with_name("studies") / "lightest_frame.toml"
-
-
-def _derivative_check(design, point: dict, step: float = 1e-4) -> dict:
-    """The forward-mode Jacobian (per unconstrained variable) against central differences
-    of the same compiled values at ``point``: the largest error relative to each row's
-    largest entry."""
-    z0 = np.asarray(design.problem.to_z(point))
-    _, jac = design.evaluate(z0)
-    fd = np.zeros_like(jac)
-    for k in range(z0.size):
-        dz = np.zeros_like(z0)
-        dz[k] = step
-        fd[:, k] = (design.evaluate(z0 + dz)[0] - design.evaluate(z0 - dz)[0]) / (2.0 * step)
-    rows = np.max(np.abs(fd), axis=1, keepdims=True)
-    return {"jacobian": jac.tolist(), "central_differences": fd.tolist(), "step_z": step,
-            "max_relative_error": float(np.max(np.abs(jac - fd) / rows))}
 
 
 def _frame_summary(frame) -> dict:
@@ -94,7 +78,7 @@ def main():
     at_initial = dict(zip(labels, (float(x) for x in design.evaluate(np.asarray(design.problem.to_z(initial)))[0])))
     rigid = {s.name: v for s, v in design.rigid_values.items()}
     print(f"rigid car: {rigid}\nshipped frame (initial design): {at_initial}", flush=True)
-    check = _derivative_check(design, initial)
+    check = jacobian_check(design, initial)
     print(f"Jacobian vs central differences at the shipped frame: largest relative error "
           f"{check['max_relative_error']:.2e}", flush=True)
     names = [v.name for v in study.variables]
