@@ -47,6 +47,7 @@ def jacobian_check(design, point: dict, step: float = 1e-4) -> dict:
         dz[k] = step
         fd[:, k] = (design.evaluate(z0 + dz)[0] - design.evaluate(z0 - dz)[0]) / (2.0 * step)
     rows = np.max(np.abs(fd), axis=1, keepdims=True)
+    rows = np.where(rows > 0.0, rows, 1.0)
     return {"jacobian": jac.tolist(), "central_differences": fd.tolist(), "step_z": step,
             "max_relative_error": float(np.max(np.abs(jac - fd) / rows))}
 
