@@ -1,11 +1,12 @@
-"""Study (c) of issue 14 with two hard points under chassis deformation: the rear toe link's
-inner and outer point heights (rear L z, M z) for zero rear-axle roll steer at 0.05 g on the
-50 m skid-pad with zero rear bump steer (experiments/studies/rear_toe_link.toml), solved on
-the flexible 6-mode car and on the rigid car (the same study with modes = 0); each car's
+"""Study (c) of issue 14 with two hard points under chassis deformation: the heights of the
+rear toe link's inner point and of the upper wishbone's outer point (rear L z, H z) for zero
+rear-axle roll steer at 0.05 g on the 50 m skid-pad with the outer rear wheel's camber per g
+held at the rigid car's design value (experiments/studies/rear_toe_link.toml), solved on the
+flexible 6-mode car and on the rigid car (the same study with modes = 0); each car's
 Jacobian at the design against central differences; both conditions mapped over the two
 heights; and each car evaluated at the other's optimum. Writes both optimisations (history
 JSON/CSV, the optimum's car file), ``rear_toe_link.json`` and ``rear_toe_link.png`` (the
-zero lines of both conditions on both cars: they cross at the optima).
+lines where each condition holds, on both cars: they cross at the optima).
 
     python experiments/rear_toe_link.py                  # results/rear_toe_link/
 
@@ -47,7 +48,9 @@ def main():
     grids = [np.linspace(max(v.lower, v.initial - MAP_HALF_WIDTH), min(v.upper, v.initial + MAP_HALF_WIDTH),
                          MAP_POINTS) for v in variables]
     report = {"study": str(STUDY), "variables": [{"name": v.name, "path": v.path} for v in variables],
-              "initial": initial, "grids": [g.tolist() for g in grids]}
+              "initial": initial, "grids": [g.tolist() for g in grids],
+              "conditions": {base.terms[0].spec.name: base.terms[0].target,
+                             base.constraints[0].spec.name: base.constraints[0].bound}}
     designs = {}
     for label, modes in (("flexible", base.modes), ("rigid", 0)):
         study = base._replace(modes=modes, name=f"rear_toe_link_{label}", out=str(args.out / label))
@@ -85,26 +88,26 @@ def _figure(report: dict, path: Path) -> None:
     (a, b) = (v["name"] for v in report["variables"])
     x, y = (np.asarray(g) * 1e3 for g in report["grids"])
     fig, axes = plt.subplots(1, 2, figsize=(11.5, 4.8))
-    panels = (("rear_steer_gradient", "rear-axle steer gradient at 0.05 g (deg/g)"),
-              ("bump_steer", "rear bump steer (deg/m)"))
-    for ax, (q, title) in zip(axes, panels):
+    titles = {"rear_steer_gradient": "rear-axle steer gradient at 0.05 g (deg/g)",
+              "camber_gradient": "outer rear wheel's camber gradient at 0.05 g (deg/g)"}
+    for ax, (q, level) in zip(axes, report["conditions"].items()):
         flexible = np.asarray(report["flexible"]["map"][q])
         cs = ax.contourf(y, x, flexible, levels=15, cmap="RdBu_r")
         fig.colorbar(cs, ax=ax, label=f"{q}, flexible car")
         for label, style in (("flexible", "-"), ("rigid", "--")):
             values = np.asarray(report[label]["map"][q])
-            ax.contour(y, x, values, levels=[0.0], colors="k", linestyles=style)
+            ax.contour(y, x, values, levels=[level], colors="k", linestyles=style)
             opt = report[label]["optimum"]
             ax.plot(opt[b] * 1e3, opt[a] * 1e3, "*" if label == "flexible" else "o", ms=12, color="gold",
-                    mec="k", label=f"optimum, {label}: L {opt[a] * 1e3:.2f}, M {opt[b] * 1e3:.2f} mm")
+                    mec="k", label=f"optimum, {label}: {opt[a] * 1e3:.2f}, {opt[b] * 1e3:.2f} mm")
         ax.plot([report["initial"][b] * 1e3], [report["initial"][a] * 1e3], "kx", ms=9, label="design (Appendix B)")
-        ax.plot([], [], "k-", label="zero line, flexible (6 modes)")
-        ax.plot([], [], "k--", label="zero line, rigid")
+        ax.plot([], [], "k-", label=f"{q} = {level:g}, flexible (6 modes)")
+        ax.plot([], [], "k--", label=f"{q} = {level:g}, rigid")
         ax.set_xlabel(f"{b} (mm)")
         ax.set_ylabel(f"{a} (mm)")
-        ax.set_title(title, fontsize=10)
+        ax.set_title(titles.get(q, q), fontsize=10)
         ax.legend(fontsize=7, loc="lower right")
-    fig.suptitle("Rear toe link: zero rear-axle roll steer (R = 50 m) and zero bump steer")
+    fig.suptitle("Rear L z and H z: zero rear-axle roll steer with the rigid car's outer rear camber per g (R = 50 m)")
     fig.tight_layout()
     fig.savefig(path, dpi=150)
 
