@@ -114,6 +114,7 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
         "speed_kmh": float(manoeuvre.speed) * 3.6,
         "duration_s": float(manoeuvre.duration),
         "rtol": rtol,
+        "solver": run.solver,
         "wall_time_s": run.wall_s,
         "steps": int(run.steps),
         "rejected_steps": int(run.rejected_steps),

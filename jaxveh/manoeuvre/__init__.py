@@ -46,10 +46,12 @@ from ._road import (
     four_post as four_post,
 )
 from ._simulate import (
+    AUTO_IMEX_RTOL as AUTO_IMEX_RTOL,
     EVENTS as EVENTS,
     SOLVERS as SOLVERS,
     CarRun as CarRun,
     manoeuvre_channels as manoeuvre_channels,
+    pick_solver as pick_solver,
     save_times as save_times,
     simulate as simulate,
     start_trim as start_trim,

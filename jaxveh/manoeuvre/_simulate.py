@@ -16,7 +16,6 @@ from collections.abc import Callable
 import diffrax
 import equinox as eqx
 import jax
-import jax.flatten_util
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
@@ -40,12 +39,27 @@ from ..vehicle import (
 from ..vehicle._setup import CHASSIS_FORWARD, CHASSIS_LATERAL
 from ._channels import UNITS, car_channels
 from ._driver import AbstractSteeringLaw, Manoeuvre
+from ._imex import imex_solver, linearised_split
 from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
 
-#: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; KenCarp4 IMEX with the
-#: chassis modes' linearised dynamics implicit; the fully implicit Kvaerno5.
+#: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; KenCarp4 IMEX (the fast
+#: car: its linearisation at the start implicit, :mod:`._imex`; the library car: its chassis
+#: modes' forces implicit); the fully implicit Kvaerno5.
 SOLVERS = ("tsit5", "kencarp4", "kvaerno5")
+#: ``solver="auto"`` (the default of :func:`simulate`) takes KenCarp4 on the fast car from this
+#: rtol up (2-3 times faster than Tsit5 at 1e-4 and 1e-3, about equal at 1e-6) and Tsit5 below
+#: it and on the library car (docs/manoeuvre.md, "Solvers").
+AUTO_IMEX_RTOL = 1e-5
+
+
+def pick_solver(solver: str, form: str, rtol: float) -> str:
+    """The solver of :data:`SOLVERS` that ``solver`` ("auto" or one of them) names for a run in
+    ``form`` at ``rtol``."""
+    if solver != "auto":
+        _solver(solver)
+        return solver
+    return "kencarp4" if form == "fast" and rtol >= AUTO_IMEX_RTOL else "tsit5"
 #: First step (s): given rather than estimated, which would compile two more copies of the
 #: vector field; the controller adapts it from the first step on.
 FIRST_STEP = 1e-3
@@ -57,7 +71,8 @@ ROLLOVER_ANGLE, SPIN_ANGLE = 1.0, 1.2  # rad (57 deg, 69 deg)
 
 class CarRun(eqx.Module):
     """A manoeuvre's result: save times ``ts`` (s), ``channels`` (name -> array with a
-    leading time axis, units in ``units``), the ``form`` that ran, the Diffrax step counts,
+    leading time axis, units in ``units``), the ``form`` and ``solver`` that ran, the Diffrax
+    step counts,
     ``status`` (0 completed, 1 stopped by an event, 2 solver failure), ``stop_reason``
     ("completed", the event or the failure and its time, or "traced" under ``jit``),
     ``wall_s`` (s, after compilation when the caller compiled first; NaN under ``jit``) and
@@ -73,22 +88,25 @@ class CarRun(eqx.Module):
     stop_reason: str = eqx.field(static=True, default="traced")
     wall_s: float = eqx.field(static=True, default=float("nan"))
     valid: Array | None = None
+    solver: str = eqx.field(static=True, default="")
 
     @property
     def units(self) -> dict:
         return {k: UNITS.get(k, "m") for k in self.channels}
 
 
-def _solver(name: str):
+def _solver(name: str, form: str = "library"):
     if name == "tsit5":
         return diffrax.Tsit5()
+    if name == "kencarp4" and form == "fast":
+        return imex_solver()
     if name in ("kencarp4", "kvaerno5"):
         import optimistix as optx
 
         # Newton, not Diffrax's default chord iteration (far more steps on this problem)
         newton = optx.Newton(rtol=1e-8, atol=1e-10)
         return diffrax.KenCarp4(root_finder=newton) if name == "kencarp4" else diffrax.Kvaerno5(root_finder=newton)
-    raise ParameterError(f"solver = {name!r} is not available: allowed {', '.join(map(repr, SOLVERS))}")
+    raise ParameterError(f"solver = {name!r} is not available: allowed 'auto', {', '.join(map(repr, SOLVERS))}")
 
 
 class _Driving(eqx.Module):
@@ -140,12 +158,12 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps,
         out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], driving.angle(t, s.aux))
         return out | {"constraint_residual": d.link_residual}
 
-    terms = _imex_terms(field, s0, car.n_modes) if solver == "kencarp4" else diffrax.ODETerm(field)
+    terms = linearised_split(field, s0) if solver == "kencarp4" else diffrax.ODETerm(field)
     conditions = tuple(lambda t, s, args, fn=fn, **kw: fn(s.q, s.u) for fn in (_rolled_over, _spun))
     # the states at the save times (dense output), then the channels in one vectorised pass:
     # a save function would be traced five times by Diffrax and sit inside the step loop
     sol = diffrax.diffeqsolve(
-        terms, _solver(solver), 0.0, manoeuvre.duration, FIRST_STEP, s0, saveat=diffrax.SaveAt(ts=ts),
+        terms, _solver(solver, "fast"), 0.0, manoeuvre.duration, FIRST_STEP, s0, saveat=diffrax.SaveAt(ts=ts),
         event=diffrax.Event(conditions), stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol),
         max_steps=max_steps, throw=False, **({} if adjoint is None else {"adjoint": adjoint}))
     rolled, spun = sol.event_mask
@@ -169,30 +187,6 @@ def _spun(q, u):
 
 def _event_code(rolled, spun):
     return jnp.where(rolled, 1, jnp.where(spun, 2, 0))
-
-
-def _imex_terms(field, s0: FastState, n_modes: int):
-    """``(explicit, implicit)`` terms of the fast car for an IMEX solver: the implicit part
-    is the vector field's linearisation at the start restricted to the modal coordinates
-    and rates (the stiff, lightly damped chassis modes), ``J_m (x - x0)``; the explicit part
-    is the rest, so the two add up to the exact vector field."""
-    x0, unravel = jax.flatten_util.ravel_pytree(s0)
-
-    def flat(x):
-        return jax.flatten_util.ravel_pytree(field(0.0, unravel(x), None))[0]
-
-    n = s0.q.shape[0]
-    modal = np.concatenate([np.arange(6, 6 + n_modes), n + np.arange(6, 6 + n_modes)])
-    jac = jax.jacfwd(flat)(x0)
-    j_modal = jnp.zeros_like(jac).at[:, modal].set(jac[:, modal])
-
-    def implicit(t, s, args):
-        return unravel(j_modal @ (jax.flatten_util.ravel_pytree(s)[0] - x0))
-
-    def explicit(t, s, args):
-        return jax.tree.map(jnp.subtract, field(t, s, args), implicit(t, s, args))
-
-    return diffrax.MultiTerm(diffrax.ODETerm(explicit), diffrax.ODETerm(implicit))
 
 
 def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint):
@@ -305,13 +299,15 @@ def save_times(manoeuvre: Manoeuvre, points: int):
     return jnp.linspace(0.0, manoeuvre.duration, points)
 
 
-def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "tsit5",
+def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "auto",
              rtol: float = 1e-4, atol: float | None = None, max_steps: int = 100_000, throw: bool = True,
              freeze_steps: int = 0, trim=None) -> CarRun:
     """Run ``manoeuvre`` on ``car`` (compiled once per car structure and solver) and return a
     :class:`CarRun` with ``points`` save times. ``form``: "fast" or "library" (default: the
     car's own, ``car.form``). ``rtol``/``atol``: the PID step-size controller's tolerances
     (default ``atol = rtol / 100`` on every state: metres, radians, modal coordinates).
+    ``solver``: one of :data:`SOLVERS`, or "auto" (:func:`pick_solver`: KenCarp4 IMEX on the
+    fast car from rtol :data:`AUTO_IMEX_RTOL` up, else Tsit5); the run's is ``CarRun.solver``.
     A run stops early when the car rolls over or spins (:data:`EVENTS`; ``status`` 1,
     ``stop_reason`` names the event and its time). A failed solve raises ``RuntimeError``
     naming the last time reached (``throw=False``: the run is returned with ``status`` 2).
@@ -321,7 +317,6 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     for a simplified one) instead of the car's own. After a stop the channels hold their last
     reached values (``valid`` marks the save times reached)."""
     form = check_form(car.form if form is None else form)
-    _solver(solver)
     if not (isinstance(points, int) and points >= 2):
         raise ParameterError(f"points = {points!r} is out of range: allowed integers >= 2 (save times)")
     if not 0.0 < rtol < 1.0:
@@ -329,6 +324,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     atol = rtol * 1e-2 if atol is None else atol
     if not atol > 0.0:
         raise ParameterError(f"atol = {atol!r} is out of range: allowed > 0")
+    solver = pick_solver(solver, form, rtol)
     _check_steering(manoeuvre)
     _check_freeze_steps(freeze_steps, form)
     ts = save_times(manoeuvre, points)
@@ -359,4 +355,5 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
         if throw:
             raise RuntimeError(f"the {form} car's integration failed: {reason}")
     return CarRun(ts=ts, channels=channels, steps=stats["num_steps"], rejected_steps=stats["num_rejected_steps"],
-                  status=jnp.asarray(status), form=form, stop_reason=reason, wall_s=wall, valid=jnp.asarray(valid))
+                  status=jnp.asarray(status), form=form, stop_reason=reason, wall_s=wall, valid=jnp.asarray(valid),
+                  solver=solver)
