@@ -195,8 +195,7 @@ def test_imex_is_the_default_and_as_accurate_in_fewer_steps(runs):
     reference = _channels(runs[6, "fast"])
     imex = simulate(car, step_steer(angle=ANGLE))
     explicit = simulate(car, step_steer(angle=ANGLE), solver="tsit5")
-    assert imex.solver == "kencarp4" and explicit.solver == "tsit5"
-    assert simulate(car, step_steer(angle=ANGLE, duration=COMPARED), rtol=TIGHT).solver == "tsit5"
+    assert imex.solver == "kencarp4" and explicit.solver == "tsit5" and runs[6, "fast"].solver == "tsit5"
     for run in (imex, explicit):
         assert run.stop_reason == "completed"
         for name, value in _channels(run).items():
