@@ -1,6 +1,7 @@
 """Car benchmark (issue 11): the default 6-mode flexible car (2.5 % modal damping), a 5 s
 step steer at 90 km/h, in the fast form (minimal coordinates) against the library car and
-the CommonRoad multi-body model.
+the CommonRoad multi-body model, with ``simulate``'s default solver at rtol 1e-4 (KenCarp4
+IMEX on the fast car, Tsit5 on the library car; ``--solver`` to choose).
 
 Measures, through the public ``jaxveh.manoeuvre`` API: compile time (the straight-running
 trim plus the run), the run's wall time after compilation (best of three; the trim is
@@ -29,7 +30,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaxveh  # noqa: F401  (float64)
-from jaxveh.manoeuvre import manoeuvre_channels, save_times, step_steer, straight_trim
+from jaxveh.manoeuvre import SOLVERS, manoeuvre_channels, pick_solver, save_times, step_steer, straight_trim
 from jaxveh.vehicle import load_car
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -58,12 +59,13 @@ def _best(fn, *args, repeats=3):
     return min(walls)
 
 
-def runner(form: str):
+def runner(form: str, solver: str):
     """Jitted ``(car, trim, angle, rtol) -> (channels, stats, status)``."""
 
     def run(car, trim, angle, rtol):
         m = step_steer(speed=SPEED, angle=angle, start=START, rise=RISE, duration=DURATION)
-        return manoeuvre_channels(car, m, save_times(m, POINTS), form=form, trim=trim, rtol=rtol, atol=rtol * 1e-2)
+        return manoeuvre_channels(car, m, save_times(m, POINTS), form=form, trim=trim, rtol=rtol, atol=rtol * 1e-2,
+                                  solver=solver)
 
     return eqx.filter_jit(run)
 
@@ -79,13 +81,14 @@ def max_rel_error(a: dict, b: dict) -> tuple[float, str]:
     return worst, name
 
 
-def overshoot_fn(car):
+def overshoot_fn(car, solver: str):
     """Yaw-rate overshoot of the step steer (fraction) as a function of ``CarParams``."""
 
     def overshoot(params):
         c = eqx.tree_at(lambda x: x.params, car, params)
         m = step_steer(speed=SPEED, angle=ANGLE, start=START, rise=RISE, duration=DURATION)
-        ch, _, _ = manoeuvre_channels(c, m, save_times(m, POINTS), form="fast", rtol=RTOL, atol=RTOL * 1e-2)
+        ch, _, _ = manoeuvre_channels(c, m, save_times(m, POINTS), form="fast", rtol=RTOL, atol=RTOL * 1e-2,
+                                      solver=solver)
         r = ch["yaw_rate"]
         return (jnp.max(r) - r[-1]) / r[-1]
 
@@ -121,13 +124,13 @@ def bench_peer(delta: float) -> dict | None:
             "final_yaw_rate_deg_s": float(np.degrees(sol.y[5, -1]))}
 
 
-def bench(quick: bool, log) -> dict:
+def bench(quick: bool, solver: str, log) -> dict:
     car = load_car(modes=6)
-    res: dict = {}
+    res: dict = {"solver": pick_solver(solver, "fast", RTOL)}
     trim_fn = eqx.filter_jit(straight_trim)
     trim, res["trim_compile_s"] = _timed(trim_fn, car, SPEED, "fast")
     res["trim_s"] = _best(trim_fn, car, SPEED, "fast")
-    fast = runner("fast")
+    fast = runner("fast", res["solver"])
     rtol = jnp.asarray(RTOL)
     (ch, stats, status), first = _timed(fast, car, trim, ANGLE, rtol)
     if int(status) != 0:
@@ -144,14 +147,14 @@ def bench(quick: bool, log) -> dict:
     log(f"fast car: compile {res['compile_s']:.0f} s (trim {res['trim_compile_s']:.0f} s), run {res['wall_s']:.2f} s, "
         f"{res['steps']} steps ({res['rejected_steps']} rejected), trim {res['trim_s']:.2f} s")
 
-    library = runner("library")
+    library = runner("library", pick_solver(solver, "library", RTOL))
     library_trim = trim_fn(car, SPEED, "library")
     (_, lstats, _), res["library_compile_s"] = _timed(library, car, library_trim, ANGLE, rtol)
     res["library_wall_s"] = _best(library, car, library_trim, ANGLE, rtol, repeats=2)
     res["library_steps"] = int(lstats["num_steps"])
     log(f"library car: run {res['library_wall_s']:.2f} s, {res['library_steps']} steps")
     tight = jnp.asarray(REFERENCE_RTOL)
-    ref_fast, _, _ = fast(car, trim, ANGLE, tight)
+    ref_fast, _, _ = runner("fast", "tsit5")(car, trim, ANGLE, tight)
     ref_lib, _, _ = library(car, library_trim, ANGLE, tight)
     res["max_rel_error_vs_library"], res["worst_channel"] = max_rel_error(ref_fast, ref_lib)
     res["max_rel_error_vs_library_at_rtol"] = max_rel_error(ch, ref_lib)[0]
@@ -170,7 +173,7 @@ def bench(quick: bool, log) -> dict:
         log(f"batch {n}: {n / wall:.2f} sims/s")
 
     if not quick:
-        overshoot = overshoot_fn(car)
+        overshoot = overshoot_fn(car, res["solver"])
         forward = eqx.filter_jit(overshoot)
         grad = eqx.filter_jit(eqx.filter_grad(overshoot))
         _, res["forward_compile_s"] = _timed(forward, car.params)
@@ -197,7 +200,7 @@ def bench(quick: bool, log) -> dict:
     return res
 
 
-KEYS = ("compile_s", "wall_s", "steps", "batch_sims_per_s", "grad_over_forward", "max_rel_error_vs_library",
+KEYS = ("solver", "compile_s", "wall_s", "steps", "batch_sims_per_s", "grad_over_forward", "max_rel_error_vs_library",
         "library_wall_s", "peer_wall_s")
 
 
@@ -206,13 +209,15 @@ def main():
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout (progress on stderr)")
     parser.add_argument("--quick", action="store_true", help="batches 1 and 16 only, no gradient (smoke test)")
     parser.add_argument("--out", type=Path, help="also write bench_car.json into this folder")
+    parser.add_argument("--solver", default="auto", choices=("auto",) + SOLVERS,
+                        help="the runs at rtol 1e-4 (auto: simulate's default; the rtol 1e-8 references: tsit5)")
     args = parser.parse_args()
 
     def log(msg):
         print(msg, file=sys.stderr if args.json else sys.stdout, flush=True)
 
     t0 = time.perf_counter()
-    res = bench(args.quick, log)
+    res = bench(args.quick, args.solver, log)
     res["total_s"] = time.perf_counter() - t0
     summary = {k: res[k] for k in KEYS} | {"details": {k: v for k, v in res.items() if k not in KEYS}}
     if args.out is not None:
