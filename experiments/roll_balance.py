@@ -83,7 +83,8 @@ def _figure(report: dict, path: Path) -> None:
         if label in report:
             r = report[label]
             ax.plot([r["lambda"]], [r["understeer_gradient_deg_per_g"]], "*", ms=14, color=colour,
-                    label=f"optimum, {label}: λ = {r['lambda']:.4f}")
+                    label=f"{'optimum' if r['converged'] else 'last iterate (not converged)'}, {label}: "
+                          f"λ = {r['lambda']:.4f}")
     ax.axhline(report["target_deg_per_g"], color="k", lw=0.8, ls="--", label="target")
     ax.set_xlabel("roll stiffness distribution λ = kF / (kF + kR)")
     ax.set_ylabel(f"understeer gradient at {report['ay_g']:g} g (deg/g)")
