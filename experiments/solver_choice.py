@@ -1,6 +1,7 @@
 """Solver choice for the car's manoeuvres (issue 11, item 4): explicit Tsit5 against IMEX
-KenCarp4 (the chassis modes' linearised dynamics implicit) and fully implicit Kvaerno5 (both
-with Optimistix's Newton), on the fast 6-mode car's 5 s step steer at 90 km/h, at the
+KenCarp4 (the car's linearisation at the start implicit, one factorisation per step:
+jaxveh.manoeuvre._imex) and fully implicit Kvaerno5 (Optimistix's Newton), on the fast
+6-mode car's 5 s step steer at 90 km/h, at the
 thesis's tolerances (0.5 % and 0.1 %) and at 1e-4, against an rtol 1e-9 Tsit5 reference:
 steps, wall time after compilation, and the worst relative error of yaw rate, ay, roll and
 the modal coordinates (each over its largest value).
