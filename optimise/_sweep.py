@@ -1,6 +1,8 @@
 """Sensitivity maps at scale: a study's grid (:mod:`optimise._study`) evaluated in chunks of
-one shape, each chunk one vmapped, compiled call, checkpointed to disk and gathered into an
-xarray Dataset (netCDF) with contour / line plots.
+one shape, each chunk one compiled call (the chapter-3 model vmapped over the chunk; the
+car's designs one after the other inside the call, ``jax.lax.map``, since batching them
+batches LAPACK solves, which can deadlock jaxlib 0.10.2 on CPU: docs/optimise.md),
+checkpointed to disk and gathered into an xarray Dataset (netCDF) with contour / line plots.
 
 The grid's points are numbered in C order (the first variable outermost) and cut into
 chunks of ``study.chunk`` points; the last chunk is padded with copies of the grid's last
@@ -242,12 +244,15 @@ def car_designs(car, study: Study, points: np.ndarray, memo: Optional[dict] = No
 
 def _objectives_batch(car, designs, specs, prepared, speeds):
     """The objectives ``specs`` of the car with each of the stacked ``designs``, at each of
-    ``speeds`` (km/h; ``None``: the specs' own)."""
-    def one(p, speed):
+    ``speeds`` (km/h; ``None``: the specs' own), one design after the other inside the
+    compiled call (``jax.lax.map``: batched LAPACK solves can deadlock, as in
+    :func:`jaxveh.analysis.load_transfer_batch`)."""
+    def one(args):
+        p, speed = args
         overrides = None if speed is None else {"speed_kmh": speed}
         return objective_values(eqx.tree_at(lambda c: c.params, car, p), specs, prepared, overrides=overrides)
 
-    return jax.vmap(one)(designs, speeds)
+    return jax.lax.map(one, (designs, speeds))
 
 
 _compiled_objectives = eqx.filter_jit(_objectives_batch)

@@ -114,8 +114,12 @@ def _with(car, params):
 
 
 def _batched(car, params, ay, radius) -> LoadTransfer:
-    """:func:`_transfers` vmapped over stacked car parameters ``params`` (leading axis)."""
-    return jax.vmap(lambda p: _transfers(_with(car, p), ay, radius))(params)
+    """:func:`_transfers` of each of the stacked car parameters ``params`` (leading axis), one
+    after the other inside the compiled call (``jax.lax.map``). Not ``jax.vmap``: batching the
+    designs batches their steady states' LAPACK solves, and two such batched solves running
+    at once deadlock jaxlib 0.10.2's CPU thread pool (seen in sweeps and in study (a),
+    docs/optimise.md); batching gained under 15 % on the car."""
+    return jax.lax.map(lambda p: _transfers(_with(car, p), ay, radius), params)
 
 
 _compiled_batch = eqx.filter_jit(_batched)
@@ -146,8 +150,8 @@ def _check_radius(radius) -> float:
 def load_transfer_batch(car, params, ay_g=AY_GRID_G, radius=SKID_PAD_RADIUS) -> LoadTransfer:
     """:class:`LoadTransfer` of the car with each of the stacked :class:`~jaxveh.vehicle.CarParams`
     ``params`` (leading axis: the designs) at the lateral accelerations ``ay_g`` (g) on
-    ``radius`` (m): one vmapped, compiled call (one program per mode count, number of
-    designs and number of ay values)."""
+    ``radius`` (m): one compiled call (one program per mode count, number of designs and
+    number of ay values; the designs one after the other, :func:`_batched`)."""
     check_x64()
     ay = jnp.asarray(_check_ay(ay_g) * GRAVITY)
     radius = jnp.asarray(_check_radius(radius))
