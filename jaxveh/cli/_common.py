@@ -8,8 +8,9 @@ import typer
 
 
 def new_app(help: str, **options) -> typer.Typer:
-    """A Typer (sub-)application whose help texts are printed as written: Rich markup is
-    off, so units and file keys in square brackets (``[deg]``, ``[run] out``) stay visible."""
+    """A Typer (sub-)application whose help texts keep square brackets: Rich's Markdown mode
+    instead of its markup, which takes units and file keys (``[deg]``, ``[run] out``) for
+    tags and drops them."""
     return typer.Typer(help=help, no_args_is_help=True, rich_markup_mode="markdown", **options)
 
 

@@ -1,6 +1,5 @@
 """Top-level ``jaxveh`` Typer application; each sub-command group lives in its own module."""
 
-
 from ._analytic import app as analytic_app
 from ._chassis import app as chassis_app
 from ._common import new_app
