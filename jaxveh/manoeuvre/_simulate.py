@@ -51,15 +51,6 @@ SOLVERS = ("tsit5", "kencarp4", "kvaerno5")
 #: rtol up (2-3 times faster than Tsit5 at 1e-4 and 1e-3, about equal at 1e-6) and Tsit5 below
 #: it and on the library car (docs/manoeuvre.md, "Solvers").
 AUTO_IMEX_RTOL = 1e-5
-
-
-def pick_solver(solver: str, form: str, rtol: float) -> str:
-    """The solver of :data:`SOLVERS` that ``solver`` ("auto" or one of them) names for a run in
-    ``form`` at ``rtol``."""
-    if solver != "auto":
-        _solver(solver)
-        return solver
-    return "kencarp4" if form == "fast" and rtol >= AUTO_IMEX_RTOL else "tsit5"
 #: First step (s): given rather than estimated, which would compile two more copies of the
 #: vector field; the controller adapts it from the first step on.
 FIRST_STEP = 1e-3
@@ -72,8 +63,7 @@ ROLLOVER_ANGLE, SPIN_ANGLE = 1.0, 1.2  # rad (57 deg, 69 deg)
 class CarRun(eqx.Module):
     """A manoeuvre's result: save times ``ts`` (s), ``channels`` (name -> array with a
     leading time axis, units in ``units``), the ``form`` and ``solver`` that ran, the Diffrax
-    step counts,
-    ``status`` (0 completed, 1 stopped by an event, 2 solver failure), ``stop_reason``
+    step counts, ``status`` (0 completed, 1 stopped by an event, 2 solver failure), ``stop_reason``
     ("completed", the event or the failure and its time, or "traced" under ``jit``),
     ``wall_s`` (s, after compilation when the caller compiled first; NaN under ``jit``) and
     ``valid`` (per save time: reached before the stop; later values hold the last reached
@@ -107,6 +97,15 @@ def _solver(name: str, form: str = "library"):
         newton = optx.Newton(rtol=1e-8, atol=1e-10)
         return diffrax.KenCarp4(root_finder=newton) if name == "kencarp4" else diffrax.Kvaerno5(root_finder=newton)
     raise ParameterError(f"solver = {name!r} is not available: allowed 'auto', {', '.join(map(repr, SOLVERS))}")
+
+
+def pick_solver(solver: str, form: str, rtol: float) -> str:
+    """The solver of :data:`SOLVERS` that ``solver`` ("auto" or one of them) names for a run in
+    ``form`` at ``rtol``."""
+    if solver != "auto":
+        _solver(solver)
+        return solver
+    return "kencarp4" if form == "fast" and rtol >= AUTO_IMEX_RTOL else "tsit5"
 
 
 class _Driving(eqx.Module):
