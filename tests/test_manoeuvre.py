@@ -18,9 +18,13 @@ from jaxveh.manoeuvre import (
     PATH_CHANNELS,
     UNITS,
     CarRun,
+    Manoeuvre,
     RampSteer,
     StepSteer,
+    Straight,
     SweptSine,
+    four_post,
+    kink_times,
     run_dataset,
     simulate,
     start_trim,
@@ -58,6 +62,24 @@ def test_ramp_and_sweep():
     # instantaneous frequency (Hz) = phase rate / 2 pi: linear from f0 to f1
     phase_rate = jax.grad(lambda t: jnp.arcsin(sweep(t) / 0.1))(0.01)
     np.testing.assert_allclose(phase_rate / (2 * np.pi), 0.015, rtol=1e-6)
+
+
+def test_kink_times_are_where_a_derivative_jumps():
+    """The times handed to the step-size controller: the ends of the step's rise (where its
+    second derivative jumps by 6 A / rise^2), of the ramp's blend and of the sweeps; none for
+    a constant steering wheel on a flat road."""
+    law = StepSteer(amplitude=0.1, start=0.5, rise=0.2)
+    second = jax.grad(jax.grad(law))
+    for t, jump in ((0.5, 6 * 0.1 / 0.2**2), (0.7, 6 * 0.1 / 0.2**2)):
+        np.testing.assert_allclose(abs(float(second(t + 1e-9) - second(t - 1e-9))), jump, rtol=1e-6)
+    np.testing.assert_allclose(float(second(0.6 + 1e-9) - second(0.6 - 1e-9)), 0.0, atol=1e-6)
+    np.testing.assert_allclose(kink_times(Manoeuvre(steering=law, speed=25.0, duration=5.0)), [0.5, 0.7])
+    ramp = Manoeuvre(steering=RampSteer(rate=0.2, start=1.0, blend=0.1), speed=10.0, duration=5.0)
+    np.testing.assert_allclose(kink_times(ramp), [1.0, 1.1])
+    sweep = SweptSine(amplitude=0.1, f0=0.0, f1=15.0, sweep=10.0, start=0.5)
+    np.testing.assert_allclose(kink_times(Manoeuvre(steering=sweep, speed=10.0, duration=12.0)), [0.5, 10.5])
+    np.testing.assert_allclose(kink_times(four_post(sweep=20.0, start=0.5)), [0.5, 20.5])
+    assert kink_times(Manoeuvre(steering=Straight(), speed=10.0, duration=1.0)) is None
 
 
 @pytest.mark.parametrize("make, match", [

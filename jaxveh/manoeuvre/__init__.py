@@ -13,6 +13,7 @@ from ._driver import (
     RampSteer as RampSteer,
     StepSteer as StepSteer,
     SweptSine as SweptSine,
+    kink_times as kink_times,
     step_steer as step_steer,
 )
 from ._export import run_dataset as run_dataset, write_netcdf as write_netcdf

@@ -49,6 +49,10 @@ class PostSweep(AbstractRoad):
     def height(self, x, y, t, wheel):
         return self.phases[wheel] * self.displacement(t) + jnp.zeros_like(x + y)
 
+    def kinks(self):
+        """Start and end of the sweep (s): derivative jumps of the post motion."""
+        return (self.start, self.start + self.sweep)
+
 
 class Straight(AbstractSteeringLaw):
     """No steering: the steering wheel held at the straight-running angle."""

@@ -38,7 +38,7 @@ from ..vehicle import (
 )
 from ..vehicle._setup import CHASSIS_FORWARD, CHASSIS_LATERAL
 from ._channels import UNITS, car_channels
-from ._driver import AbstractSteeringLaw, Manoeuvre
+from ._driver import AbstractSteeringLaw, Manoeuvre, kink_times
 from ._imex import imex_solver, linearised_split
 from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
@@ -163,7 +163,8 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps,
     # a save function would be traced five times by Diffrax and sit inside the step loop
     sol = diffrax.diffeqsolve(
         terms, _solver(solver, "fast"), 0.0, manoeuvre.duration, FIRST_STEP, s0, saveat=diffrax.SaveAt(ts=ts),
-        event=diffrax.Event(conditions), stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol),
+        event=diffrax.Event(conditions),
+        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol, jump_ts=kink_times(manoeuvre)),
         max_steps=max_steps, throw=False, **({} if adjoint is None else {"adjoint": adjoint}))
     rolled, spun = sol.event_mask
     status = jnp.where(sol.result == diffrax.RESULTS.successful, 0,
@@ -210,7 +211,7 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_ste
     aux0 = jnp.concatenate([trim.aux, driving.aux0])
     sim = mb.simulate(car.system, system_params(car), trim.static.q, trim.z, 0.0, manoeuvre.duration, ts,
                       inputs=law, elements=elements, aux0=aux0, outputs=outputs, solver=_solver(solver),
-                      rtol=rtol, atol=atol, dt0=FIRST_STEP, max_steps=max_steps,
+                      rtol=rtol, atol=atol, dt0=FIRST_STEP, max_steps=max_steps, jump_ts=kink_times(manoeuvre),
                       implicit_modes=solver == "kencarp4", freeze_steps=freeze_steps, throw=False,
                       events={"rollover": lambda t, st: rolled(st), "spin": lambda t, st: spun(st)})
     event = jnp.where(sim.status == 1, _event_code(rolled(sim.final), spun(sim.final)), 0)

@@ -420,6 +420,7 @@ def simulate(
     rtol: float = 1e-9,
     atol: float = 1e-11,
     dt0: float | None = None,
+    jump_ts=None,
     max_steps: int = 100_000,
     kappa=DEFAULT_KAPPA,
     adjoint=None,
@@ -439,7 +440,7 @@ def simulate(
     saved ``q``: save times never force integrator steps. ``events``: ``{name: cond(t,
     state) -> bool}``; the run stops when one becomes True and ``stop_reason`` names it.
     ``solver`` defaults to ``Tsit5``, adaptive steps with a PID controller at ``rtol`` /
-    ``atol``. Drift control: the velocity-level stabilisation ``Phi_dot = -kappa Phi`` and,
+    ``atol``; ``jump_ts`` (s): times where the inputs' derivatives jump, where steps end. Drift control: the velocity-level stabilisation ``Phi_dot = -kappa Phi`` and,
     with ``project``, a Newton projection of ``q`` after every step
     (:class:`ProjectedSolver`). ``implicit_modes``: integrate the flexible bodies' linear
     elastic and damping forces implicitly and the rest explicitly (IMEX, :mod:`._imex`);
@@ -492,7 +493,7 @@ def simulate(
         y0=State(q0, z0, aux0),
         args=(params, inputs, external, args),
         saveat=diffrax.SaveAt(ts=ts, t1=True),  # t1: where the run actually ended (events)
-        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol),
+        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol, jump_ts=jump_ts),
         max_steps=max_steps,
         adjoint=diffrax.RecursiveCheckpointAdjoint() if adjoint is None else adjoint,
         event=None if event is None else event[0],
