@@ -116,5 +116,6 @@ def kink_times(manoeuvre: Manoeuvre):
     (``kinks()`` of either; closed-loop drivers have none), as an array for Diffrax's
     ``PIDController(jump_ts=...)``, or None. Steps that end there are not rejected for the
     jump: 302 -> 274 steps and 30 -> 10 rejections on the benchmark step steer."""
-    times = [*getattr(manoeuvre.steering, "kinks", tuple)(), *getattr(manoeuvre.road, "kinks", tuple)()]
+    steering = manoeuvre.steering.kinks() if isinstance(manoeuvre.steering, AbstractSteeringLaw) else ()
+    times = [*steering, *manoeuvre.road.kinks()]
     return jnp.stack([jnp.asarray(t, jnp.float64) for t in times]) if times else None

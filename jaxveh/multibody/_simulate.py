@@ -440,8 +440,9 @@ def simulate(
     saved ``q``: save times never force integrator steps. ``events``: ``{name: cond(t,
     state) -> bool}``; the run stops when one becomes True and ``stop_reason`` names it.
     ``solver`` defaults to ``Tsit5``, adaptive steps with a PID controller at ``rtol`` /
-    ``atol``; ``jump_ts`` (s): times where the inputs' derivatives jump, where steps end. Drift control: the velocity-level stabilisation ``Phi_dot = -kappa Phi`` and,
-    with ``project``, a Newton projection of ``q`` after every step
+    ``atol``; ``jump_ts`` (s): times where the inputs' derivatives jump, where steps end.
+    Drift control: the velocity-level stabilisation ``Phi_dot = -kappa Phi`` and, with
+    ``project``, a Newton projection of ``q`` after every step
     (:class:`ProjectedSolver`). ``implicit_modes``: integrate the flexible bodies' linear
     elastic and damping forces implicitly and the rest explicitly (IMEX, :mod:`._imex`);
     ``solver`` then defaults to ``KenCarp4`` with a Newton root finder and must be an IMEX

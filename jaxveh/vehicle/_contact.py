@@ -60,6 +60,11 @@ class AbstractRoad(eqx.Module):
     def height(self, x, y, t, wheel):
         """Road height (m)."""
 
+    def kinks(self) -> tuple:
+        """Times (s) where a derivative of the road's motion jumps, where the integrator
+        ends its steps (none by default)."""
+        return ()
+
 
 class FlatRoad(AbstractRoad):
     """The plane ``z = 0``."""
