@@ -259,6 +259,34 @@ def _point_rates(car, model, lay, m: CarMotion, velocity, a_up, q):
     return xd, om
 
 
+def _corner_sum(corner, x):
+    """Sums of the rows of ``x`` (n, 3) by their corner (static, n): (4, 3), as one product."""
+    return jnp.asarray(np.eye(4)[corner].T, x.dtype) @ x
+
+
+def _applied_wrenches(car, model, lay, m: CarMotion, a_up, q, rack, forces, torques):
+    """The point forces and torques (global axes, library order) as generalised forces:
+    the chassis's ``(n_c,)`` (force, moment in chassis axes and the modal forces of the
+    translational and rotational mode shapes) and, per corner, the upright's force and
+    moment about its centre and the wheel's moment about its hub (upright axes; the wheel's
+    force is the upright's). The point-velocity Jacobian transposed, body by body."""
+    local, shapes, rshapes, inputs, up, wh = _point_tables(car, model.params, lay)
+    ch = lay["chassis_points"]
+    x_ch = local + shapes @ q[6:6 + car.n_modes] + rack * inputs
+    f_ch, t_ch = _mv(m.a_c.T[None], forces[ch]), _mv(m.a_c.T[None], torques[ch])
+    modal = jnp.einsum("pim,pi->m", shapes, f_ch) + jnp.einsum("pim,pi->m", rshapes, t_ch)
+    q_chassis = jnp.concatenate([f_ch.sum(0), (jnp.cross(x_ch, f_ch) + t_ch).sum(0), modal])
+    uc, wc = lay["upright_corner"], lay["wheel_corner"]
+    a_upt = jnp.swapaxes(a_up, 1, 2)
+    up_ix, wh_ix = lay["upright_points"], lay["wheel_points"]
+    f_up, t_up = _mv(a_upt[uc], forces[up_ix]), _mv(a_upt[uc], torques[up_ix])
+    f_wh, t_wh = _mv(a_upt[wc], forces[wh_ix]), _mv(a_upt[wc], torques[wh_ix])
+    force = _corner_sum(uc, f_up) + _corner_sum(wc, f_wh)
+    moment = _corner_sum(uc, jnp.cross(up, f_up) + t_up)
+    wheel_moment = _corner_sum(wc, jnp.cross(_mv(m.spin_rot[wc], wh), f_wh) + t_wh)
+    return q_chassis, (force, moment, wheel_moment)
+
+
 # ---- equations -------------------------------------------------------------------------------
 
 
@@ -338,13 +366,6 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
         vcc, trr, srr = split(car, uu)
         return _velocities(m, m.corners, vcc, trr, srr, jnp.zeros_like(rack))
 
-    def point_rates(uu):
-        return _point_rates(car, model, lay, m, body_velocities(uu), a_up, q)
-
-    # generalised forces by the point-velocity Jacobian (forward mode: gathers, where the
-    # transpose of the point-rate map scatters)
-    jac_x, jac_om = jax.jacfwd(point_rates)(u)
-    q_applied = jnp.einsum("pia,pi->a", jac_x, forces) + jnp.einsum("pia,pi->a", jac_om, torques)
     _, jac_v, jac_w, jac_wh = jax.jacfwd(body_velocities)(u)
     v_acc, w_acc = _bias(m, vc, travel_rate)
     chassis = params.bodies[0]
@@ -353,7 +374,8 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     quad_el, grav = body_forces(system, params, 0, (m.r_c, a_c, q[6:6 + car.n_modes]), vc)
     n_c = 6 + car.n_modes
     m_red = jnp.zeros((u.shape[0], u.shape[0])).at[:n_c, :n_c].add(m_c)
-    rhs = jnp.zeros_like(u).at[:n_c].add(quad_el + grav) + q_applied
+    q_chassis, (f_ap, t_ap, t_ap_wh) = _applied_wrenches(car, model, lay, m, a_up, q, rack, forces, torques)
+    rhs = jnp.zeros_like(u).at[:n_c].add(quad_el + grav + q_chassis)
     _, v_up, w_up, w_wheel = m.velocity
     mass = jnp.stack([params.bodies[i].mass for i in lay["uprights"]])
     inertia = jnp.stack([params.bodies[i].inertia for i in lay["uprights"]])
@@ -367,8 +389,8 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     t_wh = -spin[:, None] * w_acc * jnp.asarray(_EY) - jnp.cross(w_wheel, h_wh)
     m_red = m_red + jnp.einsum("kia,k,kib->ab", jac_v, mass, jac_v) + jnp.einsum(
         "kia,kij,kjb->ab", jac_w, inertia, jac_w) + jnp.einsum("ka,k,kb->ab", jac_wh[:, 1], spin, jac_wh[:, 1])
-    rhs = rhs + jnp.einsum("kia,ki->a", jac_v, f_up) + jnp.einsum("kia,ki->a", jac_w, t_up) + jnp.einsum(
-        "kia,ki->a", jac_wh, t_wh)
+    rhs = rhs + jnp.einsum("kia,ki->a", jac_v, f_up + f_ap) + jnp.einsum("kia,ki->a", jac_w, t_up + t_ap) + (
+        jnp.einsum("kia,ki->a", jac_wh, t_wh + t_ap_wh))
     u_dot = cho_solve(cho_factor(m_red), rhs)  # symmetric positive definite
     residual = pose_residual(model.geometry, split(car, q)[1], rack, q[6:6 + car.n_modes], m.corners.w)
     return FastDynamics(q_dot=q_dot, u_dot=u_dot, aux_dot=aux_dot, rack=rack, rack_rate=rack_rate, kinematics=kin,
