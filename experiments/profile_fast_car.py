@@ -45,15 +45,15 @@ def entry_ops(f, *args) -> collections.Counter:
 
 def loop_time(f, *args, repeats: int) -> float:
     """Seconds per evaluation of ``f`` inside a compiled loop of ``LOOP`` (best of
-    ``repeats``); each iteration's first argument moves by 1e-30 of the previous output's
-    sum, so nothing is hoisted out of the loop."""
+    ``repeats``); each iteration's arguments move by 1e-30 of the previous output's sum, so
+    nothing is hoisted out of the loop."""
 
     def nudge(x, acc):
         return jax.tree.map(lambda leaf: leaf + 1e-30 * acc if jnp.issubdtype(leaf.dtype, jnp.floating) else leaf, x)
 
     def loop(*a):
         def body(_, acc):
-            out = f(nudge(a[0], acc), *a[1:])
+            out = f(*nudge(a, acc))
             return sum(jnp.sum(leaf) for leaf in jax.tree.leaves(out))
 
         return jax.lax.fori_loop(0, LOOP, body, jnp.zeros(()))

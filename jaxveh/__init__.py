@@ -1,10 +1,15 @@
 """jaxveh: differentiable vehicle dynamics with a flexible chassis, in JAX.
 
-Importing jaxveh enables float64 in JAX (see :mod:`jaxveh._core`).
+Importing jaxveh enables float64 in JAX (see :mod:`jaxveh._core`) and, on the jaxlib
+versions it was measured on, XLA's classic CPU fusion emitters (see :mod:`jaxveh._xla`).
 """
 
-from . import _core as _core
-from ._core import (
+from . import _xla as _xla
+
+_xla.apply_cpu_flags()
+
+from . import _core as _core  # noqa: E402
+from ._core import (  # noqa: E402
     GRAVITY as GRAVITY,
     ParameterError as ParameterError,
     check_x64 as check_x64,
