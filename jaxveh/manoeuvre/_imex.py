@@ -20,9 +20,10 @@ import diffrax
 import equinox as eqx
 import jax
 import jax.numpy as jnp
-import jax.scipy.linalg as jsl
 import optimistix as optx
 from jax.flatten_util import ravel_pytree
+
+from .._linalg import lu_factor, lu_solve
 
 
 class _AffineState(eqx.Module):
@@ -45,13 +46,13 @@ class AffineRootFinder(optx.AbstractRootFinder):
             return options["init_state"]
         flat, unravel = ravel_pytree(y)
         jacobian = jax.jacfwd(lambda x: ravel_pytree(fn(unravel(x), args)[0])[0])(flat)
-        return _AffineState(jsl.lu_factor(jax.lax.stop_gradient(jacobian)), jnp.asarray(0))
+        return _AffineState(lu_factor(jacobian), jnp.asarray(0))
 
     def step(self, fn, y, args, options, state, tags):
         del options, tags
         fx, aux = fn(y, args)
         flat, unravel = ravel_pytree(y)
-        return unravel(flat - jsl.lu_solve(state.lu, ravel_pytree(fx)[0])), _AffineState(state.lu, state.steps + 1), aux
+        return unravel(flat - lu_solve(state.lu, ravel_pytree(fx)[0])), _AffineState(state.lu, state.steps + 1), aux
 
     def terminate(self, fn, y, args, options, state, tags):
         del fn, y, args, options, tags
