@@ -1,30 +1,25 @@
-"""Small dense linear solves that stay unbatched under ``jax.vmap``.
+"""An LU solve that stays unbatched under ``jax.vmap`` (the IMEX root finder's).
 
 jaxlib 0.10.2 splits a batched LAPACK call (a vmapped Cholesky, LU or triangular solve)
 over its CPU thread pool and waits for the parts; two such calls running at once can each
 wait for the threads the other holds, and the process hangs with no CPU (seen with vmapped
 steady states, sweeps and the fast car's batched step steers; native stacks in
-docs/optimise.md). The solves here run a batch one system after the other inside the
+docs/optimise.md). The solve here runs a batch one system after the other inside the
 compiled program (:func:`jax.custom_batching.sequential_vmap`: unbatched LAPACK calls never
 use the pool), and differentiate as linear solves (:func:`jax.lax.custom_linear_solve`:
-forward and reverse mode, the factorisation itself never differentiated). Unbatched they
-are the plain LAPACK calls.
+forward and reverse mode, the factorisation itself never differentiated). Unbatched it is
+the plain LAPACK call.
+
+The same treatment of the fast car's Cholesky solve failed: the skid-pad program (a
+Newton solve whose Jacobian is a vmapped forward-mode pass) then stopped at run time with
+"No registered implementation for untyped custom call to lapack_dpotrf_ffi", so that solve
+stays a plain batched LAPACK call (docs/manoeuvre.md, "Speed").
 """
 
 import jax
 import jax.scipy.linalg as jsl
 
 _sequential = jax.custom_batching.sequential_vmap
-
-
-@_sequential
-def _cholesky(m):
-    return jax.lax.linalg.cholesky(m)
-
-
-@_sequential
-def _cholesky_solve(factor, b):
-    return jsl.cho_solve((factor, True), b)
 
 
 @_sequential
@@ -40,12 +35,6 @@ def _lu_solve(lu, pivots, b):
 @_sequential
 def _lu_solve_transposed(lu, pivots, b):
     return jsl.lu_solve((lu, pivots), b, trans=1)
-
-
-def spd_solve(m, b):
-    """``m^-1 b`` for a symmetric positive definite ``m`` (n, n) and ``b`` (n,), by Cholesky."""
-    factor = _cholesky(jax.lax.stop_gradient(m))
-    return jax.lax.custom_linear_solve(lambda x: m @ x, b, lambda _, r: _cholesky_solve(factor, r), symmetric=True)
 
 
 def lu_factor(a):

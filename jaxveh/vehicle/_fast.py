@@ -24,9 +24,9 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.scipy.linalg import cho_factor, cho_solve
 from jaxtyping import Array, Float
 
-from .._linalg import spd_solve
 from ..multibody import Kinematics, SystemParams, body_forces, element_forces, input_state, rotation_matrix
 from ..multibody._inputs import as_inputs
 from ..multibody._rotations import elementary, skew
@@ -391,7 +391,7 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
         "kia,kij,kjb->ab", jac_w, inertia, jac_w) + jnp.einsum("ka,k,kb->ab", jac_wh[:, 1], spin, jac_wh[:, 1])
     rhs = rhs + jnp.einsum("kia,ki->a", jac_v, f_up + f_ap) + jnp.einsum("kia,ki->a", jac_w, t_up + t_ap) + (
         jnp.einsum("kia,ki->a", jac_wh, t_wh + t_ap_wh))
-    u_dot = spd_solve(m_red, rhs)
+    u_dot = cho_solve(cho_factor(m_red), rhs)  # symmetric positive definite
     residual = pose_residual(model.geometry, split(car, q)[1], rack, q[6:6 + car.n_modes], m.corners.w)
     return FastDynamics(q_dot=q_dot, u_dot=u_dot, aux_dot=aux_dot, rack=rack, rack_rate=rack_rate, kinematics=kin,
                         link_residual=residual)
