@@ -1,7 +1,7 @@
 """jaxveh: differentiable vehicle dynamics with a flexible chassis, in JAX.
 
-Importing jaxveh enables float64 in JAX (see :mod:`jaxveh._core`) and, on the jaxlib
-versions it was measured on, XLA's classic CPU fusion emitters (see :mod:`jaxveh._xla`).
+Importing jaxveh enables float64 in JAX (see :mod:`jaxveh._core`) and, with
+``JAXVEH_XLA_FLAGS=1``, XLA's classic CPU fusion emitters (see :mod:`jaxveh._xla`).
 """
 
 from . import _xla as _xla

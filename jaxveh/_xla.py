@@ -3,12 +3,14 @@
 XLA's newer CPU fusion emitters compile the car's vector field into code that runs about a
 third slower, and compiles about a third slower, than the classic loop emitters on these
 machines (the fast car's step steer: one evaluation 94 -> 71 us, compilation 46 -> 34 s,
-the same results to round-off). :func:`apply_cpu_flags` therefore adds
+the same results to round-off). With ``JAXVEH_XLA_FLAGS=1`` :func:`apply_cpu_flags` adds
 ``--xla_cpu_use_fusion_emitters=false`` to ``XLA_FLAGS`` before JAX starts its CPU backend.
+It is off by default: with it, a vmapped batch of 16 step steers hung twice in jaxlib's
+LAPACK thread pool (docs/manoeuvre.md, "Speed"), which without it happened only in sweeps.
 
 XLA aborts the process on a flag it does not know, so the flag is added only for the jaxlib
-versions it was measured on (:data:`TESTED_JAXLIB`), never when ``XLA_FLAGS`` already names
-it, and not at all with ``JAXVEH_XLA_FLAGS=0``. It has no effect when a JAX computation ran
+versions it was measured on (:data:`TESTED_JAXLIB`) and never when ``XLA_FLAGS`` already
+names it. It has no effect when a JAX computation ran
 before jaxveh was imported (the backend reads ``XLA_FLAGS`` once).
 """
 
@@ -29,7 +31,7 @@ def _jaxlib_version() -> tuple[int, ...]:
 def apply_cpu_flags(environ=os.environ, jaxlib_version: tuple[int, ...] | None = None) -> tuple[str, ...]:
     """Add :data:`CPU_FLAGS` to ``environ["XLA_FLAGS"]`` where allowed (module docs); return
     the flags added."""
-    if environ.get("JAXVEH_XLA_FLAGS", "1") == "0":
+    if environ.get("JAXVEH_XLA_FLAGS", "0") != "1":
         return ()
     version = _jaxlib_version() if jaxlib_version is None else tuple(jaxlib_version)
     if version[:2] not in TESTED_JAXLIB:

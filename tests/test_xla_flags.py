@@ -1,6 +1,6 @@
-"""The XLA CPU flags jaxveh sets on import (jaxveh._xla): only on the measured jaxlib
-versions, never twice, never against the user's own setting, and not with
-JAXVEH_XLA_FLAGS=0. XLA aborts on an unknown flag, so a wrong gate would kill the process."""
+"""The XLA CPU flags jaxveh sets on import with JAXVEH_XLA_FLAGS=1 (jaxveh._xla): only on
+the measured jaxlib versions, never twice, never against the user's own setting, and not by
+default. XLA aborts on an unknown flag, so a wrong gate would kill the process."""
 
 import os
 import subprocess
@@ -10,20 +10,21 @@ from jaxveh import _xla
 
 
 def test_flags_added_on_tested_versions_only():
-    env = {}
+    env = {"JAXVEH_XLA_FLAGS": "1"}
     assert _xla.apply_cpu_flags(env, (0, 10, 2)) == _xla.CPU_FLAGS
     assert env["XLA_FLAGS"] == " ".join(_xla.CPU_FLAGS)
     assert _xla.apply_cpu_flags(env, (0, 10, 2)) == ()  # already there: not added twice
     assert env["XLA_FLAGS"] == " ".join(_xla.CPU_FLAGS)
-    other = {}
+    other = {"JAXVEH_XLA_FLAGS": "1"}
     assert _xla.apply_cpu_flags(other, (0, 11)) == () and "XLA_FLAGS" not in other
 
 
 def test_user_setting_and_opt_out_are_kept():
-    env = {"XLA_FLAGS": "--xla_cpu_use_fusion_emitters=true --xla_force_host_platform_device_count=2"}
+    env = {"XLA_FLAGS": "--xla_cpu_use_fusion_emitters=true --xla_force_host_platform_device_count=2",
+           "JAXVEH_XLA_FLAGS": "1"}
     assert _xla.apply_cpu_flags(env, (0, 10)) == ()
     assert env["XLA_FLAGS"].startswith("--xla_cpu_use_fusion_emitters=true")
-    env = {"XLA_FLAGS": "--xla_force_host_platform_device_count=2", "JAXVEH_XLA_FLAGS": "0"}
+    env = {"XLA_FLAGS": "--xla_force_host_platform_device_count=2"}  # off by default
     assert _xla.apply_cpu_flags(env, (0, 10)) == ()
     assert env["XLA_FLAGS"] == "--xla_force_host_platform_device_count=2"
 
@@ -34,7 +35,7 @@ def test_import_sets_flags_that_this_jaxlib_accepts():
     code = ("import os, jaxveh, jax.numpy as jnp; print(float(jnp.arange(3.0).sum())); "
             "print(os.environ.get('XLA_FLAGS', ''))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
-                         env={k: v for k, v in os.environ.items() if k != "XLA_FLAGS"})
+                         env={k: v for k, v in os.environ.items() if k != "XLA_FLAGS"} | {"JAXVEH_XLA_FLAGS": "1"})
     assert out.returncode == 0, out.stderr
     total, flags = out.stdout.splitlines()[:2]
     assert total == "3.0"
