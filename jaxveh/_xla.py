@@ -1,4 +1,4 @@
-"""XLA CPU options that jaxveh sets when it is imported (docs/manoeuvre.md, "Speed").
+"""XLA CPU options jaxveh can set when it is imported, opt-in (docs/manoeuvre.md, "Speed").
 
 XLA's newer CPU fusion emitters compile the car's vector field into code that runs about a
 third slower, and compiles about a third slower, than the classic loop emitters on these
@@ -10,8 +10,7 @@ LAPACK thread pool (docs/manoeuvre.md, "Speed"), which without it happened only 
 
 XLA aborts the process on a flag it does not know, so the flag is added only for the jaxlib
 versions it was measured on (:data:`TESTED_JAXLIB`) and never when ``XLA_FLAGS`` already
-names it. It has no effect when a JAX computation ran
-before jaxveh was imported (the backend reads ``XLA_FLAGS`` once).
+names it. It has no effect when a JAX computation ran before jaxveh was imported (the backend reads ``XLA_FLAGS`` once).
 """
 
 import os
