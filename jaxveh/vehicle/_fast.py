@@ -17,16 +17,19 @@ their mass is the upright's), with ``J_b`` the partial velocities, ``a0_b`` the 
 accelerations at ``u_dot = 0`` and ``Q_b`` gravity and the car's force elements
 (:func:`jaxveh.vehicle.car_elements`, the same code as the library car, fed with the same
 :class:`jaxveh.multibody.Kinematics`). No constraint projection and no drift: the links
-close exactly at every evaluation.
+close exactly at every evaluation. A corner's velocities depend on the chassis's and on its
+own travel and spin rates only, so the mass matrix is an arrow: the corners' 2 x 2 blocks
+are eliminated in closed form and the chassis's Schur complement is solved by an unrolled
+Cholesky (no LAPACK call in the vector field, batched or not).
 """
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-from jax.scipy.linalg import cho_factor, cho_solve
 from jaxtyping import Array, Float
 
+from .._linalg import spd_solve
 from ..multibody import Kinematics, SystemParams, body_forces, element_forces, input_state, rotation_matrix
 from ..multibody._inputs import as_inputs
 from ..multibody._rotations import elementary, skew
@@ -287,6 +290,59 @@ def _applied_wrenches(car, model, lay, m: CarMotion, a_up, q, rack, forces, torq
     return q_chassis, (force, moment, wheel_moment)
 
 
+def _corner_partials(m: CarMotion, n_c: int):
+    """Partial velocities of each corner's upright, ``(G_v, G_w)`` (4, 3, n_c + 2): its
+    velocity and angular velocity (upright axes) with respect to the chassis velocities
+    ``[u, omega, modal rates]``, the corner's travel rate and its wheel's spin rate (a zero
+    column: the spin moves the wheel only). Each corner's velocities depend on no other
+    corner's rates, which :func:`_kane_solve` exploits."""
+    sens = m.corners.sens  # d w / d [travel, rack, modes]
+    a_relt = jnp.swapaxes(m.a_rel, 1, 2)
+    ones = jnp.ones((4, 1))
+    eye = jnp.broadcast_to(jnp.eye(3), (4, 3, 3))
+    # the wheel centre's velocity in chassis axes: u + omega x r + (dx, dy, travel) rates
+    lever = -jax.vmap(skew)(m.r_rel)
+    modal_v = jnp.concatenate([sens[:, :2, 2:], jnp.zeros((4, 1, sens.shape[2] - 2))], axis=1)
+    travel_v = jnp.concatenate([sens[:, :2, 0], ones], axis=1)[:, :, None]
+    b_v = jnp.concatenate([eye, lever, modal_v, travel_v, jnp.zeros((4, 3, 1))], axis=2)
+    g_v = jnp.einsum("kij,kjl->kil", a_relt, b_v)
+    # the angular velocity: the chassis's plus the angle rates through the rate matrix
+    angle_rates = jnp.einsum("kij,kjl->kil", m.e_rel, sens[:, 2:, :])  # (4, 3, 2 + n)
+    g_w = jnp.concatenate([jnp.zeros((4, 3, 3)), a_relt, angle_rates[:, :, 2:], angle_rates[:, :, :1],
+                           jnp.zeros((4, 3, 1))], axis=2)
+    return g_v, g_w
+
+
+def _inverse_2x2(a):
+    """Inverses of 2 x 2 matrices over the leading axis, in closed form."""
+    det = a[:, 0, 0] * a[:, 1, 1] - a[:, 0, 1] * a[:, 1, 0]
+    adj = jnp.stack([jnp.stack([a[:, 1, 1], -a[:, 0, 1]], -1), jnp.stack([-a[:, 1, 0], a[:, 0, 0]], -1)], -2)
+    return adj / det[:, None, None]
+
+
+def _kane_solve(m: CarMotion, m_c, f_c, mass, inertia, spin, f_up, t_up, t_wh):
+    """``u_dot`` from Kane's equations with their structure: the chassis block (``m_c``,
+    generalised force ``f_c``) coupled to each corner's travel and spin and to nothing else,
+    so the four corners' 2 x 2 blocks are eliminated in closed form and the chassis's Schur
+    complement (n_c x n_c, symmetric positive definite) is solved by an unrolled Cholesky
+    (:func:`jaxveh._linalg.spd_solve`: no LAPACK call). The corner terms: upright mass and
+    inertia (4,) (4, 3, 3), wheel spin inertia (4,), the upright's force and moment and the
+    wheel's moment (4, 3, upright axes; inertial, gravity and applied)."""
+    n_c = m_c.shape[0]
+    g_v, g_w = _corner_partials(m, n_c)
+    g_spin = g_w[:, 1, :].at[:, n_c + 1].add(1.0)  # the wheel's spin rate about the upright's y
+    mass_l = (jnp.einsum("kia,k,kib->kab", g_v, mass, g_v) + jnp.einsum("kia,kij,kjb->kab", g_w, inertia, g_w)
+              + spin[:, None, None] * g_spin[:, :, None] * g_spin[:, None, :])
+    force_l = (jnp.einsum("kia,ki->ka", g_v, f_up) + jnp.einsum("kia,ki->ka", g_w, t_up + t_wh)
+               + jnp.zeros((4, n_c + 2)).at[:, n_c + 1].set(t_wh[:, 1]))
+    m_cb, m_bb = mass_l[:, :n_c, n_c:], mass_l[:, n_c:, n_c:]
+    x = jnp.einsum("kab,kbc->kac", m_cb, _inverse_2x2(m_bb))  # (4, n_c, 2)
+    schur = m_c + mass_l[:, :n_c, :n_c].sum(0) - jnp.einsum("kac,kbc->ab", x, m_cb)
+    a_c = spd_solve(schur, f_c + force_l[:, :n_c].sum(0) - jnp.einsum("kac,kc->a", x, force_l[:, n_c:]))
+    a_b = jnp.einsum("kcd,kd->kc", _inverse_2x2(m_bb), force_l[:, n_c:] - jnp.einsum("kac,a->kc", m_cb, a_c))
+    return jnp.concatenate([a_c, a_b[:, 0], a_b[:, 1]])
+
+
 # ---- equations -------------------------------------------------------------------------------
 
 
@@ -362,36 +418,24 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     # the rack acceleration enters the corners' velocity-product terms linearly
     m = eqx.tree_at(lambda x: x.corners.w_acc0, m, m.corners.w_acc0 + m.corners.sens[:, :, 1] * rack_acc)
 
-    def body_velocities(uu):
-        vcc, trr, srr = split(car, uu)
-        return _velocities(m, m.corners, vcc, trr, srr, jnp.zeros_like(rack))
-
-    _, jac_v, jac_w, jac_wh = jax.jacfwd(body_velocities)(u)
     v_acc, w_acc = _bias(m, vc, travel_rate)
     chassis = params.bodies[0]
     m_c = chassis.mass_matrix(q[6:6 + car.n_modes], system.options)
-    a_c = m.a_c
-    quad_el, grav = body_forces(system, params, 0, (m.r_c, a_c, q[6:6 + car.n_modes]), vc)
-    n_c = 6 + car.n_modes
-    m_red = jnp.zeros((u.shape[0], u.shape[0])).at[:n_c, :n_c].add(m_c)
+    quad_el, grav = body_forces(system, params, 0, (m.r_c, m.a_c, q[6:6 + car.n_modes]), vc)
     q_chassis, (f_ap, t_ap, t_ap_wh) = _applied_wrenches(car, model, lay, m, a_up, q, rack, forces, torques)
-    rhs = jnp.zeros_like(u).at[:n_c].add(quad_el + grav + q_chassis)
     _, v_up, w_up, w_wheel = m.velocity
     mass = jnp.stack([params.bodies[i].mass for i in lay["uprights"]])
     inertia = jnp.stack([params.bodies[i].inertia for i in lay["uprights"]])
     spin = jnp.stack([params.bodies[i].inertia[1, 1] for i in lay["wheels"]])
-    g_up = _mv(jnp.swapaxes(_mm(a_c[None], m.a_rel), 1, 2), params.gravity[None, :])
+    g_up = _mv(jnp.swapaxes(_mm(m.a_c[None], m.a_rel), 1, 2), params.gravity[None, :])
     # uprights: m (v_dot + w x v) = F, J w_dot + w x J w = T (c.g. at the wheel centre)
     f_up = mass[:, None] * (g_up - v_acc - jnp.cross(w_up, v_up))
     t_up = -_mv(inertia, w_acc) - jnp.cross(w_up, _mv(inertia, w_up))
     # wheels: rotors about the upright's y axis (angular velocity w_wheel in upright axes)
     h_wh = spin[:, None] * w_wheel * jnp.asarray(_EY)
     t_wh = -spin[:, None] * w_acc * jnp.asarray(_EY) - jnp.cross(w_wheel, h_wh)
-    m_red = m_red + jnp.einsum("kia,k,kib->ab", jac_v, mass, jac_v) + jnp.einsum(
-        "kia,kij,kjb->ab", jac_w, inertia, jac_w) + jnp.einsum("ka,k,kb->ab", jac_wh[:, 1], spin, jac_wh[:, 1])
-    rhs = rhs + jnp.einsum("kia,ki->a", jac_v, f_up + f_ap) + jnp.einsum("kia,ki->a", jac_w, t_up + t_ap) + (
-        jnp.einsum("kia,ki->a", jac_wh, t_wh + t_ap_wh))
-    u_dot = cho_solve(cho_factor(m_red), rhs)  # symmetric positive definite
+    u_dot = _kane_solve(m, m_c, quad_el + grav + q_chassis, mass, inertia, spin, f_up + f_ap, t_up + t_ap,
+                        t_wh + t_ap_wh)
     residual = pose_residual(model.geometry, split(car, q)[1], rack, q[6:6 + car.n_modes], m.corners.w)
     return FastDynamics(q_dot=q_dot, u_dot=u_dot, aux_dot=aux_dot, rack=rack, rack_rate=rack_rate, kinematics=kin,
                         link_residual=residual)
