@@ -31,6 +31,7 @@ from pathlib import Path
 
 import jax
 import pytest
+from _watchdog import Watchdog
 from jax import monitoring
 
 import jaxveh  # noqa: F401  (enables float64)
@@ -147,6 +148,26 @@ def pytest_runtest_call(item):
     return (yield from _within_setup_or_call())
 
 
+_watchdog: list[Watchdog] = []
+
+
+def pytest_runtest_logstart(nodeid, location):
+    """Watch the test for a deadlock (:mod:`_watchdog`), from its set-up to its teardown."""
+    if not _watchdog and Path("/proc/self/stat").exists():
+        _watchdog.append(Watchdog())
+    for w in _watchdog:
+        w.start_test(nodeid)
+    if _MEMORY_LOG and _STATUS.exists():
+        _memory_logstart(nodeid)
+
+
+def pytest_runtest_logfinish(nodeid, location):
+    for w in _watchdog:
+        w.end_test()
+    if _MEMORY_LOG and _STATUS.exists():
+        _memory_logfinish(nodeid)
+
+
 def _within_setup_or_call():
     _in_setup_or_call[0] = True
     try:
@@ -190,11 +211,11 @@ def _status_kib(field: str) -> int:
 
 if _MEMORY_LOG and _STATUS.exists():
 
-    def pytest_runtest_logstart(nodeid, location):
+    def _memory_logstart(nodeid):
         """Reset the process's peak resident memory (VmHWM) before each test."""
         _CLEAR_REFS.write_text("5")
 
-    def pytest_runtest_logfinish(nodeid, location):
+    def _memory_logfinish(nodeid):
         """Append ``test, peak MiB, resident MiB`` (set-up, call and teardown together) to
         the file ``$JAXVEH_MEMORY_LOG``: which tests two workers must not overlap."""
         peak, now = _status_kib("VmHWM") // 1024, _status_kib("VmRSS") // 1024
