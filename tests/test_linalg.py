@@ -1,7 +1,6 @@
-"""jaxveh._linalg: the unbatched-under-vmap LU solve (the answers of NumPy, derivatives by
+"""The unbatched-under-vmap LU solve (jaxveh._linalg): the answers of NumPy, derivatives by
 central differences in forward and reverse mode, and under vmap a loop of unbatched LAPACK
-calls: a batched call can hang jaxlib 0.10.2's CPU thread pool) and the unrolled Cholesky
-solve (NumPy's answers, derivatives in the matrix and the right-hand side, no LAPACK call)."""
+calls (a batched call can hang jaxlib 0.10.2's CPU thread pool)."""
 
 import re
 
@@ -9,7 +8,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxveh._linalg import lu_factor, lu_solve, spd_solve
+from jaxveh._linalg import lu_factor, lu_solve
 
 RNG = np.random.default_rng(3)
 N = 6
@@ -65,31 +64,3 @@ def test_lu_solve_derivative_in_b_and_transpose():
     np.testing.assert_allclose(jac_rev, inverse, rtol=1e-11, atol=1e-13)
     # no derivative with respect to the factorised matrix (stop-gradient by design)
     assert float(jnp.max(jnp.abs(jax.grad(lambda s: lu_solve(lu_factor(a * s), b).sum())(1.0)))) == 0.0
-
-
-def _spd(batch=(), n=N):
-    r = RNG.normal(size=(*batch, n, n))
-    return jnp.asarray(r @ np.swapaxes(r, -1, -2) + n * np.eye(n))
-
-
-def test_spd_solve_equals_numpy_without_lapack():
-    for n in (1, 2, 12):
-        m, b = _spd((3,), n), jnp.asarray(RNG.normal(size=(3, n)))
-        expected = np.linalg.solve(np.asarray(m), np.asarray(b)[..., None])[..., 0]
-        np.testing.assert_allclose(spd_solve(m[0], b[0]), expected[0], rtol=1e-12, atol=1e-14)
-        solve = jax.jit(jax.vmap(spd_solve))
-        np.testing.assert_allclose(solve(m, b), expected, rtol=1e-12, atol=1e-14)
-        assert "custom-call" not in solve.lower(m, b).compile().as_text()
-
-
-def test_spd_solve_derivatives_equal_central_differences():
-    a, b = _spd(), jnp.asarray(RNG.normal(size=N))
-    da, db, w = _spd(), jnp.asarray(RNG.normal(size=N)), jnp.asarray(RNG.normal(size=N))
-
-    def f(e):
-        return jnp.sin(spd_solve(a + e * da, b + e * db)) @ w
-
-    h = 1e-6
-    central = (f(h) - f(-h)) / (2 * h)
-    np.testing.assert_allclose(jax.jvp(f, (0.0,), (1.0,))[1], central, rtol=1e-7)
-    np.testing.assert_allclose(jax.grad(f)(0.0), central, rtol=1e-7)

@@ -19,17 +19,17 @@ accelerations at ``u_dot = 0`` and ``Q_b`` gravity and the car's force elements
 :class:`jaxveh.multibody.Kinematics`). No constraint projection and no drift: the links
 close exactly at every evaluation. A corner's velocities depend on the chassis's and on its
 own travel and spin rates only, so the mass matrix is an arrow: the corners' 2 x 2 blocks
-are eliminated in closed form and the chassis's Schur complement is solved by an unrolled
-Cholesky (no LAPACK call in the vector field, batched or not).
+are eliminated in closed form and only the chassis's Schur complement (12 x 12 with six
+modes) is factorised.
 """
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.scipy.linalg import cho_factor, cho_solve
 from jaxtyping import Array, Float
 
-from .._linalg import spd_solve
 from ..multibody import Kinematics, SystemParams, body_forces, element_forces, input_state, rotation_matrix
 from ..multibody._inputs import as_inputs
 from ..multibody._rotations import elementary, skew
@@ -324,10 +324,10 @@ def _kane_solve(m: CarMotion, m_c, f_c, mass, inertia, spin, f_up, t_up, t_wh):
     """``u_dot`` from Kane's equations with their structure: the chassis block (``m_c``,
     generalised force ``f_c``) coupled to each corner's travel and spin and to nothing else,
     so the four corners' 2 x 2 blocks are eliminated in closed form and the chassis's Schur
-    complement (n_c x n_c, symmetric positive definite) is solved by an unrolled Cholesky
-    (:func:`jaxveh._linalg.spd_solve`: no LAPACK call). The corner terms: upright mass and
-    inertia (4,) (4, 3, 3), wheel spin inertia (4,), the upright's force and moment and the
-    wheel's moment (4, 3, upright axes; inertial, gravity and applied)."""
+    complement (n_c x n_c, symmetric positive definite) is solved by Cholesky. The corner
+    terms: upright mass and inertia (4,) (4, 3, 3), wheel spin inertia (4,), the upright's
+    force and moment and the wheel's moment (4, 3, upright axes; inertial, gravity and
+    applied)."""
     n_c = m_c.shape[0]
     g_v, g_w = _corner_partials(m, n_c)
     g_spin = g_w[:, 1, :].at[:, n_c + 1].add(1.0)  # the wheel's spin rate about the upright's y
@@ -338,7 +338,7 @@ def _kane_solve(m: CarMotion, m_c, f_c, mass, inertia, spin, f_up, t_up, t_wh):
     m_cb, m_bb = mass_l[:, :n_c, n_c:], mass_l[:, n_c:, n_c:]
     x = jnp.einsum("kab,kbc->kac", m_cb, _inverse_2x2(m_bb))  # (4, n_c, 2)
     schur = m_c + mass_l[:, :n_c, :n_c].sum(0) - jnp.einsum("kac,kbc->ab", x, m_cb)
-    a_c = spd_solve(schur, f_c + force_l[:, :n_c].sum(0) - jnp.einsum("kac,kc->a", x, force_l[:, n_c:]))
+    a_c = cho_solve(cho_factor(schur), f_c + force_l[:, :n_c].sum(0) - jnp.einsum("kac,kc->a", x, force_l[:, n_c:]))
     a_b = jnp.einsum("kcd,kd->kc", _inverse_2x2(m_bb), force_l[:, n_c:] - jnp.einsum("kac,a->kc", m_cb, a_c))
     return jnp.concatenate([a_c, a_b[:, 0], a_b[:, 1]])
 
