@@ -290,7 +290,7 @@ def _applied_wrenches(car, model, lay, m: CarMotion, a_up, q, rack, forces, torq
     return q_chassis, (force, moment, wheel_moment)
 
 
-def _corner_partials(m: CarMotion, n_c: int):
+def _corner_partials(m: CarMotion):
     """Partial velocities of each corner's upright, ``(G_v, G_w)`` (4, 3, n_c + 2): its
     velocity and angular velocity (upright axes) with respect to the chassis velocities
     ``[u, omega, modal rates]``, the corner's travel rate and its wheel's spin rate (a zero
@@ -298,12 +298,11 @@ def _corner_partials(m: CarMotion, n_c: int):
     corner's rates, which :func:`_kane_solve` exploits."""
     sens = m.corners.sens  # d w / d [travel, rack, modes]
     a_relt = jnp.swapaxes(m.a_rel, 1, 2)
-    ones = jnp.ones((4, 1))
     eye = jnp.broadcast_to(jnp.eye(3), (4, 3, 3))
     # the wheel centre's velocity in chassis axes: u + omega x r + (dx, dy, travel) rates
     lever = -jax.vmap(skew)(m.r_rel)
     modal_v = jnp.concatenate([sens[:, :2, 2:], jnp.zeros((4, 1, sens.shape[2] - 2))], axis=1)
-    travel_v = jnp.concatenate([sens[:, :2, 0], ones], axis=1)[:, :, None]
+    travel_v = jnp.concatenate([sens[:, :2, 0], jnp.ones((4, 1))], axis=1)[:, :, None]
     b_v = jnp.concatenate([eye, lever, modal_v, travel_v, jnp.zeros((4, 3, 1))], axis=2)
     g_v = jnp.einsum("kij,kjl->kil", a_relt, b_v)
     # the angular velocity: the chassis's plus the angle rates through the rate matrix
@@ -329,7 +328,7 @@ def _kane_solve(m: CarMotion, m_c, f_c, mass, inertia, spin, f_up, t_up, t_wh):
     force and moment and the wheel's moment (4, 3, upright axes; inertial, gravity and
     applied)."""
     n_c = m_c.shape[0]
-    g_v, g_w = _corner_partials(m, n_c)
+    g_v, g_w = _corner_partials(m)
     g_spin = g_w[:, 1, :].at[:, n_c + 1].add(1.0)  # the wheel's spin rate about the upright's y
     mass_l = (jnp.einsum("kia,k,kib->kab", g_v, mass, g_v) + jnp.einsum("kia,kij,kjb->kab", g_w, inertia, g_w)
               + spin[:, None, None] * g_spin[:, :, None] * g_spin[:, None, :])
