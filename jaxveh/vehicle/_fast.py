@@ -334,11 +334,11 @@ def _kane_solve(m: CarMotion, m_c, f_c, mass, inertia, spin, f_up, t_up, t_wh):
               + spin[:, None, None] * g_spin[:, :, None] * g_spin[:, None, :])
     force_l = (jnp.einsum("kia,ki->ka", g_v, f_up) + jnp.einsum("kia,ki->ka", g_w, t_up + t_wh)
                + jnp.zeros((4, n_c + 2)).at[:, n_c + 1].set(t_wh[:, 1]))
-    m_cb, m_bb = mass_l[:, :n_c, n_c:], mass_l[:, n_c:, n_c:]
-    x = jnp.einsum("kab,kbc->kac", m_cb, _inverse_2x2(m_bb))  # (4, n_c, 2)
+    m_cb, inv_bb = mass_l[:, :n_c, n_c:], _inverse_2x2(mass_l[:, n_c:, n_c:])
+    x = jnp.einsum("kab,kbc->kac", m_cb, inv_bb)  # (4, n_c, 2)
     schur = m_c + mass_l[:, :n_c, :n_c].sum(0) - jnp.einsum("kac,kbc->ab", x, m_cb)
     a_c = cho_solve(cho_factor(schur), f_c + force_l[:, :n_c].sum(0) - jnp.einsum("kac,kc->a", x, force_l[:, n_c:]))
-    a_b = jnp.einsum("kcd,kd->kc", _inverse_2x2(m_bb), force_l[:, n_c:] - jnp.einsum("kac,a->kc", m_cb, a_c))
+    a_b = jnp.einsum("kcd,kd->kc", inv_bb, force_l[:, n_c:] - jnp.einsum("kac,a->kc", m_cb, a_c))
     return jnp.concatenate([a_c, a_b[:, 0], a_b[:, 1]])
 
 
