@@ -151,21 +151,20 @@ def pytest_runtest_call(item):
 _watchdog: list[Watchdog] = []
 
 
-def pytest_runtest_logstart(nodeid, location):
-    """Watch the test for a deadlock (:mod:`_watchdog`), from its set-up to its teardown."""
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    """Watch the test for a deadlock (:mod:`_watchdog`), from its set-up to its teardown, in
+    the process that runs it (never in pytest-xdist's controller, whose process tree holds
+    every worker)."""
     if not _watchdog and Path("/proc/self/stat").exists():
         _watchdog.append(Watchdog())
     for w in _watchdog:
-        w.start_test(nodeid)
-    if _MEMORY_LOG and _STATUS.exists():
-        _memory_logstart(nodeid)
-
-
-def pytest_runtest_logfinish(nodeid, location):
-    for w in _watchdog:
-        w.end_test()
-    if _MEMORY_LOG and _STATUS.exists():
-        _memory_logfinish(nodeid)
+        w.start_test(item.nodeid)
+    try:
+        return (yield)
+    finally:
+        for w in _watchdog:
+            w.end_test()
 
 
 def _within_setup_or_call():
@@ -211,11 +210,11 @@ def _status_kib(field: str) -> int:
 
 if _MEMORY_LOG and _STATUS.exists():
 
-    def _memory_logstart(nodeid):
+    def pytest_runtest_logstart(nodeid, location):
         """Reset the process's peak resident memory (VmHWM) before each test."""
         _CLEAR_REFS.write_text("5")
 
-    def _memory_logfinish(nodeid):
+    def pytest_runtest_logfinish(nodeid, location):
         """Append ``test, peak MiB, resident MiB`` (set-up, call and teardown together) to
         the file ``$JAXVEH_MEMORY_LOG``: which tests two workers must not overlap."""
         peak, now = _status_kib("VmHWM") // 1024, _status_kib("VmRSS") // 1024
