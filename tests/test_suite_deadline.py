@@ -1,6 +1,6 @@
 """The suite's deadline (tests/conftest.py): CI's bound on a cold compilation cache.
 
-Each check runs an inner pytest on this suite's own conftest with a light module and one
+Each check runs an inner pytest on this suite's own conftest (and the watchdog it imports) with a light module and one
 named like a heavy module (``test_vehicle_car.py``)."""
 
 import time
@@ -11,6 +11,7 @@ import pytest
 pytest_plugins = ["pytester"]
 
 CONFTEST = (Path(__file__).parent / "conftest.py").read_text()
+WATCHDOG = (Path(__file__).parent / "_watchdog.py").read_text()
 
 LIGHT = """
 import pytest
@@ -40,7 +41,7 @@ def test_heavy_after():
 def suite(pytester):
     pytester.makeconftest(CONFTEST)
     pytester.makeini("[pytest]\nmarkers =\n    slow: long test\n")
-    pytester.makepyfile(test_light=LIGHT, test_vehicle_car=HEAVY)
+    pytester.makepyfile(test_light=LIGHT, test_vehicle_car=HEAVY, _watchdog=WATCHDOG)
     return pytester
 
 
