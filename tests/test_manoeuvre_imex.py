@@ -2,7 +2,8 @@
 finder against NumPy's solve, the linearised split adding up to the vector field, and
 KenCarp4 with both on a stiff oscillator coupled to a slow pendulum against SciPy's
 implicit Radau at tight tolerance, and derivatives through the solve (reverse and forward
-mode) against a central difference. The car's step steer with it, and its step count against
+mode) against a central difference; the same in time segments linearised again at each
+segment's start (``relinearised_solve``), and a stop by an event in a segment. The car's step steer with it, and its step count against
 the explicit solver's: tests/test_manoeuvre.py."""
 
 import diffrax
@@ -10,10 +11,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
+import pytest
 import scipy.integrate
 
 import jaxveh  # noqa: F401  (float64)
-from jaxveh.manoeuvre._imex import AffineRootFinder, imex_solver, linearised_split
+from jaxveh.manoeuvre._imex import AffineRootFinder, imex_solver, linearised_split, relinearised_solve
 
 
 def test_affine_root_finder_solves_in_one_step():
@@ -41,6 +43,9 @@ def test_linearised_split_adds_up_to_the_field():
     np.testing.assert_allclose(total, _stiff_field(0.3, y, None), rtol=1e-13, atol=1e-9)
     jac = jax.jacfwd(lambda x: terms.terms[1].vf(0.0, x, None))(y)  # the implicit part: J at y0
     np.testing.assert_allclose(jac, jax.jacfwd(lambda x: _stiff_field(0.0, x, None))(y0), rtol=1e-13)
+    at_t = linearised_split(lambda t, y, args: _stiff_field(t, y, args) * (1.0 + t), y0, t0=2.0)
+    jac = jax.jacfwd(lambda x: at_t.terms[1].vf(0.0, x, None))(y)  # linearised at t0 = 2 s
+    np.testing.assert_allclose(jac, 3.0 * jax.jacfwd(lambda x: _stiff_field(0.0, x, None))(y0), rtol=1e-13)
 
 
 def test_imex_matches_radau():
@@ -57,6 +62,63 @@ def test_imex_matches_radau():
     assert np.all(errors <= [1e-10, 1e-7, 1e-10, 1e-10]), errors
 
 
+def _radau(y0, ts):
+    return scipy.integrate.solve_ivp(lambda t, y: _stiff_field(t, y, None, np=np), (0.0, float(ts[-1])),
+                                     np.asarray(y0), method="Radau", t_eval=np.asarray(ts), rtol=1e-11, atol=1e-13)
+
+
+def _never(t, y, args, **kwargs):
+    return False
+
+
+def _segmented_pendulum(segments):
+    y0 = jnp.asarray([0.01 * np.sin(1.0), 0.0, 1.0, 0.0])
+    ts = jnp.linspace(0.0, 5.0, 51)
+    return relinearised_solve(_stiff_field, y0, 5.0, ts, segments=segments,
+                              controller=diffrax.PIDController(rtol=1e-8, atol=1e-10), event=diffrax.Event(_never),
+                              dt0=1e-3, max_steps=100_000), _radau(y0, ts)
+
+
+@pytest.mark.parametrize("segments", [3, 7])
+def test_relinearised_solve_matches_radau(segments):
+    """Every segment linearised at its start (the pendulum swings far from the first
+    linearisation), saves from the segment each time falls in: rtol 1e-8 against Radau at
+    1e-11 (as one linearisation is, test_imex_matches_radau), in fewer steps than one
+    linearisation takes."""
+    sol, ref = _segmented_pendulum(segments)
+    assert int(sol.status) == 0 and not bool(np.any(sol.event_mask))
+    errors = np.max(np.abs(np.asarray(sol.ys) - ref.y.T), axis=0)
+    assert np.all(errors <= [1e-10, 1e-7, 1e-10, 1e-10]), errors
+    assert int(sol.stats["num_steps"]) == int(sol.stats["num_accepted_steps"] + sol.stats["num_rejected_steps"])
+    once, _ = _segmented_pendulum(1)
+    assert int(sol.stats["num_steps"]) < int(once.stats["num_steps"])
+
+
+def test_relinearised_solve_stops_at_an_event():
+    """A stop in the second of four segments: the states before the event, the later save
+    times inf (as Diffrax fills them), the later segments skipped (no steps), status 1 and the
+    event's mask; Tsit5 without the split alike."""
+    def field(t, y, args):
+        return jnp.stack([jnp.ones_like(y[0]), -y[1]])
+
+    def crossed(t, y, args, **kwargs):
+        return y[0] > 1.5
+
+    ts = jnp.linspace(0.0, 4.0, 41)
+    for split in (True, False):
+        sol = relinearised_solve(field, jnp.asarray([0.0, 1.0]), 4.0, ts, segments=4,
+                                 controller=diffrax.PIDController(rtol=1e-8, atol=1e-10),
+                                 event=diffrax.Event((_never, crossed)), dt0=1e-2, max_steps=10_000, split=split)
+        reached = np.asarray(ts) <= 1.5
+        assert int(sol.status) == 1 and [bool(m) for m in sol.event_mask] == [False, True]
+        np.testing.assert_allclose(np.asarray(sol.ys)[reached, 1], np.exp(-np.asarray(ts)[reached]), rtol=1e-6)
+        assert np.all(np.isinf(np.asarray(sol.ys)[np.asarray(ts) > 1.65]))  # (1.6 may hold the stop's state)
+        single = relinearised_solve(field, jnp.asarray([0.0, 1.0]), 2.0, ts[:21], segments=2,
+                                    controller=diffrax.PIDController(rtol=1e-8, atol=1e-10),
+                                    event=diffrax.Event((_never, crossed)), dt0=1e-2, max_steps=10_000, split=split)
+        assert int(sol.stats["num_steps"]) == int(single.stats["num_steps"])  # segments 3 and 4 took none
+
+
 def _pendulum_end(gravity, adjoint):
     """The pendulum's angle at 2 s with gravity ``gravity`` (the oscillator stiff, IMEX)."""
     def field(t, y, args):
@@ -67,6 +129,32 @@ def _pendulum_end(gravity, adjoint):
     sol = diffrax.diffeqsolve(linearised_split(field, y0), imex_solver(), 0.0, 2.0, 1e-3, y0, adjoint=adjoint,
                               stepsize_controller=diffrax.PIDController(rtol=1e-9, atol=1e-11), max_steps=100_000)
     return sol.ys[-1, 2]
+
+
+def _pendulum_end_segments(gravity, adjoint):
+    """:func:`_pendulum_end` in three segments, each linearised at its start."""
+    def field(t, y, args):
+        x, v, p, w = y
+        return jnp.stack([v, -500.0**2 * (x - 0.01 * jnp.sin(p)) - 10.0 * v, w, -gravity * jnp.sin(p) + x])
+
+    y0 = jnp.asarray([0.01 * jnp.sin(1.0), 0.0, 1.0, 0.0])
+    sol = relinearised_solve(field, y0, 2.0, jnp.asarray([2.0]), segments=3, adjoint=adjoint,
+                             controller=diffrax.PIDController(rtol=1e-9, atol=1e-11), event=diffrax.Event(_never),
+                             dt0=1e-3, max_steps=100_000)
+    return sol.ys[-1, 2]
+
+
+def test_derivatives_through_the_relinearised_solve():
+    """Reverse and forward mode through the segments (the linearisations included) equal a
+    central difference, and the angle equals one linearisation's."""
+    g, h = 10.0, 1e-4
+    plain = diffrax.RecursiveCheckpointAdjoint()
+    np.testing.assert_allclose(_pendulum_end_segments(g, plain), _pendulum_end(g, plain), rtol=1e-7)
+    fd = (_pendulum_end_segments(g + h, plain) - _pendulum_end_segments(g - h, plain)) / (2 * h)
+    reverse = jax.grad(lambda x: _pendulum_end_segments(x, plain))(g)
+    _, forward = jax.jvp(lambda x: _pendulum_end_segments(x, diffrax.ForwardMode()), (g,), (1.0,))
+    np.testing.assert_allclose(reverse, fd, rtol=1e-6)
+    np.testing.assert_allclose(forward, fd, rtol=1e-6)
 
 
 def test_derivatives_through_the_imex_solve():

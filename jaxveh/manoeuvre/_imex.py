@@ -8,6 +8,12 @@ the tyres' relaxation at speed / relaxation length, wheel hop and wheel spin) ar
 linear about the start, so the explicit remainder is no longer stiff and the step follows
 the manoeuvre.
 
+As the car turns away from the state it was linearised at, the remainder grows stiff again
+and the steps shrink (the benchmark step steer: 45 steps of 44 ms over its last 2 s).
+:func:`relinearised_solve` therefore cuts the run into equal time segments and linearises
+again at the start of each, one compiled segment solve in a ``lax.scan``; three segments
+take the step steer from 274 to about 210 steps (docs/manoeuvre.md, "Speed").
+
 The implicit stage equations are then affine in the unknown, so one Newton step solves
 them exactly: :class:`AffineRootFinder` factorises their Jacobian once per step (Diffrax
 computes it at the second stage and reuses it for the others, ``KenCarp4`` having one
@@ -63,12 +69,12 @@ class AffineRootFinder(optx.AbstractRootFinder):
         return y, aux, {}
 
 
-def linearised_split(field, y0) -> diffrax.MultiTerm:
+def linearised_split(field, y0, t0=0.0) -> diffrax.MultiTerm:
     """``(explicit, implicit)`` Diffrax terms of ``field(t, y, args)`` for an IMEX solver:
-    the implicit part is the field's linearisation at ``(0, y0)`` over every state,
+    the implicit part is the field's linearisation at ``(t0, y0)`` over every state,
     ``J0 (y - y0)``, the explicit part the rest, so the two add up to ``field``."""
     x0, unravel = ravel_pytree(y0)
-    jacobian = jax.jacfwd(lambda x: ravel_pytree(field(0.0, unravel(x), None))[0])(x0)
+    jacobian = jax.jacfwd(lambda x: ravel_pytree(field(t0, unravel(x), None))[0])(x0)
 
     def implicit(t, y, args):
         return unravel(jacobian @ (ravel_pytree(y)[0] - x0))
@@ -83,3 +89,70 @@ def imex_solver() -> diffrax.KenCarp4:
     """``KenCarp4`` (4th order, L-stable implicit part) with :class:`AffineRootFinder`, for
     the terms of :func:`linearised_split`."""
     return diffrax.KenCarp4(root_finder=AffineRootFinder())
+
+
+class SegmentedSolution(eqx.Module):
+    """What :func:`relinearised_solve` returns: ``ys`` the states at the save times (inf
+    after a stop, as Diffrax fills them), ``status`` (0 completed, 1 stopped by an event, 2
+    solver failure), ``event_mask`` (which event condition stopped the run) and ``stats``
+    (steps, accepted and rejected steps summed over the segments)."""
+
+    ys: object
+    status: jax.Array
+    event_mask: tuple
+    stats: dict
+
+
+def _status(result):
+    code = jnp.where(result == diffrax.RESULTS.successful, 0, jnp.where(result == diffrax.RESULTS.event_occurred, 1, 2))
+    return code.astype(jnp.int32)
+
+
+_COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
+
+
+def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, dt0, max_steps: int,
+                       adjoint=None, split: bool = True) -> SegmentedSolution:
+    """Integrate ``field(t, y, args)`` from ``y0`` at t = 0 to ``t1`` (s), saving at ``ts``
+    (s, in [0, t1]) by Diffrax's dense output, in ``segments`` equal time segments. With
+    ``split`` each segment takes KenCarp4 IMEX on :func:`linearised_split` at its own start
+    state; without it Tsit5 on ``field``. A segment starts with the mean accepted step of the
+    one before (``dt0`` the first); ``controller``, ``event``, ``max_steps`` (per segment)
+    and ``adjoint`` go to every segment's ``diffeqsolve``. After a stop (an event or a
+    failure) the later segments are skipped. One compiled segment solve, run in a
+    ``lax.scan``: the program holds the vector field as often as one solve does."""
+    solver = imex_solver() if split else diffrax.Tsit5()
+    edges = jnp.linspace(0.0, t1, segments + 1)
+    n_conditions = len(jax.tree.leaves(event.cond_fn, is_leaf=callable))
+    options = {} if adjoint is None else {"adjoint": adjoint}
+
+    def run(y, dt, a, b):
+        terms = linearised_split(field, y, a) if split else diffrax.ODETerm(field)
+        sol = diffrax.diffeqsolve(terms, solver, a, b, dt, y, saveat=diffrax.SaveAt(ts=jnp.clip(ts, a, b), t1=True),
+                                  event=event, stepsize_controller=controller, max_steps=max_steps, throw=False,
+                                  **options)
+        counts = jnp.stack([jnp.asarray(sol.stats[k], jnp.int32) for k in _COUNTS])
+        mask = jnp.stack([jnp.asarray(m, bool) for m in jax.tree.leaves(sol.event_mask)])
+        return (jax.tree.map(lambda x: x[:-1], sol.ys), jax.tree.map(lambda x: x[-1], sol.ys), _status(sol.result),
+                mask, counts)
+
+    def skip(y, dt, a, b):
+        del dt, a, b
+        return (jax.tree.map(lambda x: jnp.full(ts.shape + x.shape, jnp.inf, x.dtype), y), y, jnp.asarray(0, jnp.int32),
+                jnp.zeros(n_conditions, bool), jnp.zeros(len(_COUNTS), jnp.int32))
+
+    def segment(carry, ab):
+        y, dt, status = carry
+        a, b = ab
+        ys, y_end, seg_status, mask, counts = jax.lax.cond(status != 0, skip, run, y, dt, a, b)
+        mean_step = jnp.minimum((b - a) / jnp.maximum(counts[1], 1).astype(b.dtype), b - a)
+        return (y_end, mean_step, jnp.maximum(status, seg_status)), (ys, mask, counts)
+
+    dt0 = jnp.asarray(dt0, ts.dtype)
+    start = (y0, dt0, jnp.asarray(0, jnp.int32))
+    (_, _, status), (ys, masks, counts) = jax.lax.scan(segment, start, (edges[:-1], edges[1:]))
+    # each save time from the segment it falls in (the last one holds t1)
+    which = jnp.clip(jnp.searchsorted(edges, ts, side="right") - 1, 0, segments - 1)
+    ys = jax.tree.map(lambda x: x[which, jnp.arange(ts.shape[0])], ys)
+    stats = {k: counts[:, i].sum() for i, k in enumerate(_COUNTS)} | {"max_steps": max_steps}
+    return SegmentedSolution(ys=ys, status=status, event_mask=tuple(masks.any(axis=0)), stats=stats)

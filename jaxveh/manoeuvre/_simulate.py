@@ -39,7 +39,7 @@ from ..vehicle import (
 from ..vehicle._setup import CHASSIS_FORWARD, CHASSIS_LATERAL
 from ._channels import UNITS, car_channels
 from ._driver import AbstractSteeringLaw, Manoeuvre, kink_times
-from ._imex import imex_solver, linearised_split
+from ._imex import imex_solver, relinearised_solve
 from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
 
@@ -51,6 +51,12 @@ SOLVERS = ("tsit5", "kencarp4", "kvaerno5")
 #: rtol up (2-3 times faster than Tsit5 at 1e-4 and 1e-3, about equal at 1e-6) and Tsit5 below
 #: it and on the library car (docs/manoeuvre.md, "Solvers").
 AUTO_IMEX_RTOL = 1e-5
+#: Linearisations of the fast car's IMEX split per run (KenCarp4 only): the run is cut into
+#: this many equal time segments, each linearised at its start (:func:`._imex.relinearised_solve`).
+#: On the benchmark step steer (5 s, rtol 1e-4) 1 / 2 / 3 / 4 / 5 / 10 of them take 274 / 229
+#: / 211 / 197 / 201 / 221 steps in 0.23 / 0.17 / 0.15 / 0.16 / 0.16 / 0.20 s: each costs a
+#: Jacobian (about 2-4 ms) and a restart (docs/manoeuvre.md, "Speed").
+LINEARISATIONS = 3
 #: First step (s): given rather than estimated, which would compile two more copies of the
 #: vector field; the controller adapts it from the first step on.
 FIRST_STEP = 1e-3
@@ -141,7 +147,7 @@ def _driving(car, manoeuvre: Manoeuvre, trim_rack, pose: int) -> _Driving:
                     lambda t, aux: aux[k])
 
 
-def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint):
+def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint, linearisations):
     del freeze_steps  # refused for the fast car, which has no projection
     driving = _driving(car, manoeuvre, trim.rack, 0)
     law, elements = driving.law, driving.elements
@@ -157,21 +163,19 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps,
         out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], driving.angle(t, s.aux))
         return out | {"constraint_residual": d.link_residual}
 
-    terms = linearised_split(field, s0) if solver == "kencarp4" else diffrax.ODETerm(field)
     conditions = tuple(lambda t, s, args, fn=fn, **kw: fn(s.q, s.u) for fn in (_rolled_over, _spun))
     # the states at the save times (dense output), then the channels in one vectorised pass:
     # a save function would be traced five times by Diffrax and sit inside the step loop
-    sol = diffrax.diffeqsolve(
-        terms, _solver(solver, "fast"), 0.0, manoeuvre.duration, FIRST_STEP, s0, saveat=diffrax.SaveAt(ts=ts),
-        event=diffrax.Event(conditions),
-        stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol, jump_ts=kink_times(manoeuvre)),
-        max_steps=max_steps, throw=False, **({} if adjoint is None else {"adjoint": adjoint}))
+    sol = relinearised_solve(
+        field, s0, manoeuvre.duration, ts, segments=linearisations if solver == "kencarp4" else 1,
+        controller=diffrax.PIDController(rtol=rtol, atol=atol, jump_ts=kink_times(manoeuvre)),
+        event=diffrax.Event(conditions), dt0=FIRST_STEP, max_steps=max_steps, adjoint=adjoint,
+        split=solver == "kencarp4")
     rolled, spun = sol.event_mask
-    status = jnp.where(sol.result == diffrax.RESULTS.successful, 0,
-                       jnp.where(sol.result == diffrax.RESULTS.event_occurred, 1, 2))
     valid = jnp.isfinite(sol.ys.q[:, 0])  # Diffrax fills the save times after a stop with inf
     states = jax.tree.map(lambda x: _hold_after_stop(x, valid), sol.ys)
     stats = dict(sol.stats) | {"event": _event_code(rolled, spun), "valid": valid}
+    status = sol.status
     return jax.vmap(channels)(ts, states), stats, status
 
 
@@ -189,8 +193,8 @@ def _event_code(rolled, spun):
     return jnp.where(rolled, 1, jnp.where(spun, 2, 0))
 
 
-def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint):
-    del adjoint  # refused for the library car (manoeuvre_channels)
+def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint, linearisations):
+    del adjoint, linearisations  # refused for the library car (manoeuvre_channels); its IMEX split is fixed
     c = car.system.body_names.index("chassis")
     q_c = car.system.q_offsets[c]  # the chassis's x, y, z, yaw, pitch, roll
     chassis = slice(q_c, q_c + 6)
@@ -219,7 +223,8 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_ste
 
 
 def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, solver: str = "tsit5", rtol=1e-4,
-                       atol=1e-6, max_steps: int = 100_000, freeze_steps: int = 0, adjoint=None):
+                       atol=1e-6, max_steps: int = 100_000, freeze_steps: int = 0, adjoint=None,
+                       linearisations: int = LINEARISATIONS):
     """``(channels, stats, status)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
     in ``form`` ("fast" or "library"), from ``trim`` (default: :func:`straight_trim`): a
     pure function of the car and the manoeuvre (jit, vmap and grad through it; reverse
@@ -228,14 +233,23 @@ def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, s
     (0 or the 1-based index into :data:`EVENTS`) and ``valid`` (save times reached);
     ``status``: 0 completed, 1 stopped by an event, 2 solver failure. ``freeze_steps``
     (library form): hold the projection matrices for that many steps
-    (:class:`jaxveh.multibody.ProjectedSolver`; 0: exact)."""
+    (:class:`jaxveh.multibody.ProjectedSolver`; 0: exact). ``linearisations`` (fast form,
+    KenCarp4): time segments of the run, each with the IMEX split linearised at its start
+    (:data:`LINEARISATIONS`; 1: once, at the start); ``max_steps`` holds per segment."""
     run = _fast if check_form(form) == "fast" else _library
     _check_freeze_steps(freeze_steps, form)
+    _check_linearisations(linearisations)
     if adjoint is not None and form != "fast":
         raise ParameterError(f"adjoint = {type(adjoint).__name__}() needs form = 'fast' (the library car integrates "
                              "with Diffrax's default adjoint)")
     trim = straight_trim(car, manoeuvre.speed, form) if trim is None else trim
-    return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint)
+    return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint, linearisations)
+
+
+def _check_linearisations(linearisations) -> None:
+    if not (isinstance(linearisations, int) and not isinstance(linearisations, bool) and linearisations >= 1):
+        raise ParameterError(f"linearisations = {linearisations!r} is out of range: allowed integers >= 1 (time "
+                             "segments of the fast car's IMEX run, each linearised at its start)")
 
 
 def _check_freeze_steps(freeze_steps, form: str) -> None:
@@ -301,7 +315,7 @@ def save_times(manoeuvre: Manoeuvre, points: int):
 
 def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int = 501, solver: str = "auto",
              rtol: float = 1e-4, atol: float | None = None, max_steps: int = 100_000, throw: bool = True,
-             freeze_steps: int = 0, trim=None) -> CarRun:
+             freeze_steps: int = 0, trim=None, linearisations: int = LINEARISATIONS) -> CarRun:
     """Run ``manoeuvre`` on ``car`` (compiled once per car structure and solver) and return a
     :class:`CarRun` with ``points`` save times. ``form``: "fast" or "library" (default: the
     car's own, ``car.form``). ``rtol``/``atol``: the PID step-size controller's tolerances
@@ -315,7 +329,8 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     ``trim``: start from this straight-running state (:func:`straight_trim` of a car with the
     same coordinates in the same form at the manoeuvre's speed, e.g. the complete model's
     for a simplified one) instead of the car's own. After a stop the channels hold their last
-    reached values (``valid`` marks the save times reached)."""
+    reached values (``valid`` marks the save times reached). ``linearisations``: see
+    :func:`manoeuvre_channels`."""
     form = check_form(car.form if form is None else form)
     if not (isinstance(points, int) and points >= 2):
         raise ParameterError(f"points = {points!r} is out of range: allowed integers >= 2 (save times)")
@@ -327,6 +342,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     solver = pick_solver(solver, form, rtol)
     _check_steering(manoeuvre)
     _check_freeze_steps(freeze_steps, form)
+    _check_linearisations(linearisations)
     ts = save_times(manoeuvre, points)
     check_car(car)  # here, so that the programs need no run-time checks (the disk cache keeps them)
     start = time.perf_counter()
@@ -341,7 +357,8 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
         # tolerances as arrays: one compilation serves every tolerance
         channels, stats, status = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
                                             rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
-                                            max_steps=max_steps, freeze_steps=freeze_steps)
+                                            max_steps=max_steps, freeze_steps=freeze_steps,
+                                            linearisations=linearisations)
         channels = jax.block_until_ready(channels)
     wall = time.perf_counter() - start
     status, valid = int(status), np.asarray(stats["valid"])
