@@ -3,8 +3,9 @@ finder against NumPy's solve, the linearised split adding up to the vector field
 KenCarp4 with both on a stiff oscillator coupled to a slow pendulum against SciPy's
 implicit Radau at tight tolerance, and derivatives through the solve (reverse and forward
 mode) against a central difference; the same in time segments linearised again at each
-segment's start (``relinearised_solve``), and a stop by an event in a segment. The car's step steer with it, and its step count against
-the explicit solver's: tests/test_manoeuvre.py."""
+segment's start (``relinearised_solve``), and a stop by an event in a segment. The car's
+step steer with it, and its step count against the explicit solver's:
+tests/test_manoeuvre.py."""
 
 import diffrax
 import jax

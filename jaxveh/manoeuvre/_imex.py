@@ -149,6 +149,10 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
         return (y_end, mean_step, jnp.maximum(status, seg_status)), (ys, mask, counts)
 
     dt0 = jnp.asarray(dt0, ts.dtype)
+    if segments == 1:  # the plain solve: no loop, no branch
+        ys, _, status, mask, counts = run(y0, dt0, edges[0], edges[1])
+        return SegmentedSolution(ys=ys, status=status, event_mask=tuple(mask),
+                                 stats={k: counts[i] for i, k in enumerate(_COUNTS)} | {"max_steps": max_steps})
     start = (y0, dt0, jnp.asarray(0, jnp.int32))
     (_, _, status), (ys, masks, counts) = jax.lax.scan(segment, start, (edges[:-1], edges[1:]))
     # each save time from the segment it falls in (the last one holds t1)
