@@ -112,16 +112,18 @@ _COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
 
 
 def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, dt0, max_steps: int,
-                       adjoint=None, split: bool = True) -> SegmentedSolution:
+                       adjoint=None, solver=None, split: bool = True) -> SegmentedSolution:
     """Integrate ``field(t, y, args)`` from ``y0`` at t = 0 to ``t1`` (s), saving at ``ts``
     (s, in [0, t1]) by Diffrax's dense output, in ``segments`` equal time segments. With
-    ``split`` each segment takes KenCarp4 IMEX on :func:`linearised_split` at its own start
-    state; without it Tsit5 on ``field``. A segment starts with the mean accepted step of the
-    one before (``dt0`` the first); ``controller``, ``event``, ``max_steps`` (per segment)
-    and ``adjoint`` go to every segment's ``diffeqsolve``. After a stop (an event or a
-    failure) the later segments are skipped. One compiled segment solve, run in a
-    ``lax.scan``: the program holds the vector field as often as one solve does."""
-    solver = imex_solver() if split else diffrax.Tsit5()
+    ``split`` each segment integrates :func:`linearised_split` at its own start state
+    (``solver`` default :func:`imex_solver`); without it ``field`` itself (``solver`` default
+    Tsit5). A segment starts with the mean accepted step of the one before (``dt0`` the
+    first); ``controller``, ``event``, ``max_steps`` (per segment) and ``adjoint`` go to
+    every segment's ``diffeqsolve``. After a stop (an event or a failure) the later segments
+    are skipped. One compiled segment solve, run in a ``lax.scan``: the program holds the
+    vector field as often as one solve does."""
+    if solver is None:
+        solver = imex_solver() if split else diffrax.Tsit5()
     edges = jnp.linspace(0.0, t1, segments + 1)
     n_conditions = len(jax.tree.leaves(event.cond_fn, is_leaf=callable))
     options = {} if adjoint is None else {"adjoint": adjoint}

@@ -170,7 +170,7 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps,
         field, s0, manoeuvre.duration, ts, segments=linearisations if solver == "kencarp4" else 1,
         controller=diffrax.PIDController(rtol=rtol, atol=atol, jump_ts=kink_times(manoeuvre)),
         event=diffrax.Event(conditions), dt0=FIRST_STEP, max_steps=max_steps, adjoint=adjoint,
-        split=solver == "kencarp4")
+        solver=_solver(solver, "fast"), split=solver == "kencarp4")
     rolled, spun = sol.event_mask
     valid = jnp.isfinite(sol.ys.q[:, 0])  # Diffrax fills the save times after a stop with inf
     states = jax.tree.map(lambda x: _hold_after_stop(x, valid), sol.ys)
