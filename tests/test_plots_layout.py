@@ -172,7 +172,16 @@ def test_manoeuvre_figure(tmp_path):
     run = {k: 10.0 * np.tanh(t - 0.5) for k in ("steering_wheel_angle", "ay", "yaw_rate", "roll", "sideslip")}
     runs = {"flexible, 6 modes": {"t_s": t, **run, "modes": 1e-3 * np.sin(np.outer(t, np.arange(1, 7)))},
             "rigid": {"t_s": t, **run, "modes": np.zeros((101, 0))}}
-    _assert_clean(plot_manoeuvre(runs, title="step-steer at 90 km/h"), tmp_path, "manoeuvre")
+    fig = plot_manoeuvre(runs, title="step-steer at 90 km/h")
+    # the six modes' legend sits above their curves (an earlier version drew it over them)
+    fig.savefig(tmp_path / "manoeuvre_legend.png", dpi=100)
+    modes = fig.axes[5]
+    box = modes.get_legend().get_window_extent(fig.canvas.get_renderer())
+    for line in modes.lines:
+        x, y = modes.transData.transform(line.get_xydata()).T
+        inside = (x > box.x0) & (x < box.x1) & (y > box.y0) & (y < box.y1)
+        assert not np.any(inside), line.get_label()
+    _assert_clean(fig, tmp_path, "manoeuvre")
     _assert_clean(plot_manoeuvre({"rigid": runs["rigid"]}, title="rigid"), tmp_path, "manoeuvre_rigid")
 
 

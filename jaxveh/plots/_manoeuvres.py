@@ -34,8 +34,13 @@ def plot_manoeuvre(runs: dict, title: str = "", t_max: float | None = None):
         if t_max is not None:
             ax.set_xlim(0, t_max)
         ax.grid(True, alpha=0.3)
-        if ax.lines:
-            ax.legend(fontsize=7, ncols=2 if which == "all" else 1)
+        if ax.lines and which == "all":
+            # one entry per mode: room above the curves for a legend in up to three rows
+            low, high = ax.get_ylim()
+            ax.set_ylim(low, high + 0.6 * (high - low))
+            ax.legend(fontsize=7, ncols=2, loc="upper center")
+        elif ax.lines:
+            ax.legend(fontsize=7)
         else:
             ax.text(0.5, 0.5, "rigid chassis: no modal coordinates", ha="center", va="center", transform=ax.transAxes)
     if title:
