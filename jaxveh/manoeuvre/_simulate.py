@@ -44,7 +44,8 @@ from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
 
 #: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; KenCarp4 IMEX (the fast
-#: car: its linearisation at the start implicit, :mod:`._imex`; the library car: its chassis
+#: car: its linearisation implicit, taken again in each of :data:`LINEARISATIONS` time
+#: segments, :mod:`._imex`; the library car: its chassis
 #: modes' forces implicit); the fully implicit Kvaerno5.
 SOLVERS = ("tsit5", "kencarp4", "kvaerno5")
 #: ``solver="auto"`` (the default of :func:`simulate`) takes KenCarp4 on the fast car from this
