@@ -30,6 +30,7 @@ import optimistix as optx
 from jax.flatten_util import ravel_pytree
 
 from .._linalg import lu_factor, lu_solve
+from ..multibody._simulate import _status
 
 
 class _AffineState(eqx.Module):
@@ -103,11 +104,6 @@ class SegmentedSolution(eqx.Module):
     stats: dict
 
 
-def _status(result):
-    code = jnp.where(result == diffrax.RESULTS.successful, 0, jnp.where(result == diffrax.RESULTS.event_occurred, 1, 2))
-    return code.astype(jnp.int32)
-
-
 _COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
 
 
@@ -135,8 +131,8 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
                                   **options)
         counts = jnp.stack([jnp.asarray(sol.stats[k], jnp.int32) for k in _COUNTS])
         mask = jnp.stack([jnp.asarray(m, bool) for m in jax.tree.leaves(sol.event_mask)])
-        return (jax.tree.map(lambda x: x[:-1], sol.ys), jax.tree.map(lambda x: x[-1], sol.ys), _status(sol.result),
-                mask, counts)
+        status = _status(sol.result).astype(jnp.int32)
+        return jax.tree.map(lambda x: x[:-1], sol.ys), jax.tree.map(lambda x: x[-1], sol.ys), status, mask, counts
 
     def skip(y, dt, a, b):
         del dt, a, b
@@ -152,13 +148,13 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
 
     dt0 = jnp.asarray(dt0, ts.dtype)
     if segments == 1:  # the plain solve: no loop, no branch
-        ys, _, status, mask, counts = run(y0, dt0, edges[0], edges[1])
-        return SegmentedSolution(ys=ys, status=status, event_mask=tuple(mask),
-                                 stats={k: counts[i] for i, k in enumerate(_COUNTS)} | {"max_steps": max_steps})
-    start = (y0, dt0, jnp.asarray(0, jnp.int32))
-    (_, _, status), (ys, masks, counts) = jax.lax.scan(segment, start, (edges[:-1], edges[1:]))
-    # each save time from the segment it falls in (the last one holds t1)
-    which = jnp.clip(jnp.searchsorted(edges, ts, side="right") - 1, 0, segments - 1)
-    ys = jax.tree.map(lambda x: x[which, jnp.arange(ts.shape[0])], ys)
+        ys, _, status, mask, count = run(y0, dt0, edges[0], edges[1])
+        masks, counts = mask[None], count[None]
+    else:
+        start = (y0, dt0, jnp.asarray(0, jnp.int32))
+        (_, _, status), (ys, masks, counts) = jax.lax.scan(segment, start, (edges[:-1], edges[1:]))
+        # each save time from the segment it falls in (the last one holds t1)
+        which = jnp.clip(jnp.searchsorted(edges, ts, side="right") - 1, 0, segments - 1)
+        ys = jax.tree.map(lambda x: x[which, jnp.arange(ts.shape[0])], ys)
     stats = {k: counts[:, i].sum() for i, k in enumerate(_COUNTS)} | {"max_steps": max_steps}
     return SegmentedSolution(ys=ys, status=status, event_mask=tuple(masks.any(axis=0)), stats=stats)
