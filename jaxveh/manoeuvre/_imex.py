@@ -73,9 +73,15 @@ class AffineRootFinder(optx.AbstractRootFinder):
 def linearised_split(field, y0, t0=0.0) -> diffrax.MultiTerm:
     """``(explicit, implicit)`` Diffrax terms of ``field(t, y, args)`` for an IMEX solver:
     the implicit part is the field's linearisation at ``(t0, y0)`` over every state,
-    ``J0 (y - y0)``, the explicit part the rest, so the two add up to ``field``."""
+    ``J0 (y - y0)``, the explicit part the rest, so the two add up to ``field``.
+
+    ``J0`` is held out of differentiation: the parts add up to ``field`` whatever the
+    matrix, so the solution depends on it only through the discretisation error, and the
+    derivatives of the run are those of the same scheme with the matrix fixed, a consistent
+    discretisation of the sensitivity equations. Derivatives of ``J0`` would be second
+    derivatives of the field, which multiply the compile time of a gradient."""
     x0, unravel = ravel_pytree(y0)
-    jacobian = jax.jacfwd(lambda x: ravel_pytree(field(t0, unravel(x), None))[0])(x0)
+    jacobian = jax.lax.stop_gradient(jax.jacfwd(lambda x: ravel_pytree(field(t0, unravel(x), None))[0])(x0))
 
     def implicit(t, y, args):
         return unravel(jacobian @ (ravel_pytree(y)[0] - x0))

@@ -197,12 +197,12 @@ def solve_small(a: Float[Array, "5 5"], b):
     return lu_solve_small(lu_small(a), b)
 
 
-def _newton(w, geometry, travel, rack, pivots, iterations: int):
+def _newton(w, geometry, travel, rack, pivots, iterations: int, unroll: bool = True):
     def step(_, w):
         res, jac = link_jacobians(w, geometry, travel, rack, pivots)[:2]
         return w - solve_small(jac, res)
 
-    return jax.lax.fori_loop(0, iterations, step, w, unroll=True)
+    return jax.lax.fori_loop(0, iterations, step, w, unroll=unroll)
 
 
 @jax.custom_jvp
@@ -271,7 +271,7 @@ def build_map(geometry: CornerGeometry) -> KinematicMap:
     def corner(g, pivots):
         def along_rack(r):
             def sweep(w, t):
-                w = _newton(w, g, t, r, pivots, MAP_ITERATIONS)
+                w = _newton(w, g, t, r, pivots, MAP_ITERATIONS, unroll=False)
                 return w, w
 
             order = np.argsort(np.abs(travel))
