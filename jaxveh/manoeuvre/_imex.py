@@ -1,12 +1,12 @@
 """IMEX integration of the fast car (docs/manoeuvre.md, "Solvers").
 
 The car's vector field is split into a linear part taken implicitly, its Jacobian at the
-start ``J0 (x - x0)`` over every state, and the rest, ``f(x) - J0 (x - x0)``, taken
-explicitly by Diffrax's additive Runge-Kutta method ``KenCarp4``; the two parts add up to
-the exact vector field. The stiff motions of the car (the chassis modes at up to 525 rad/s,
-the tyres' relaxation at speed / relaxation length, wheel hop and wheel spin) are close to
-linear about the start, so the explicit remainder is no longer stiff and the step follows
-the manoeuvre.
+start ``J0 (x - x0)`` over every state (a forward difference, held out of
+differentiation), and the rest, ``f(x) - J0 (x - x0)``, taken explicitly by Diffrax's
+additive Runge-Kutta method ``KenCarp4``; the two parts add up to the exact vector field.
+The stiff motions of the car (the chassis modes at up to 525 rad/s, the tyres' relaxation
+at speed / relaxation length, wheel hop and wheel spin) are close to linear about the
+start, so the explicit remainder is no longer stiff and the step follows the manoeuvre.
 
 As the car turns away from the state it was linearised at, the remainder grows stiff again
 and the steps shrink (the benchmark step steer: 45 steps of 44 ms over its last 2 s).
@@ -29,6 +29,7 @@ import jax.numpy as jnp
 import optimistix as optx
 from jax.flatten_util import ravel_pytree
 
+from .._differences import forward_difference_jacobian
 from .._linalg import lu_factor, lu_solve
 from ..multibody._simulate import _status
 
@@ -75,13 +76,18 @@ def linearised_split(field, y0, t0=0.0) -> diffrax.MultiTerm:
     the implicit part is the field's linearisation at ``(t0, y0)`` over every state,
     ``J0 (y - y0)``, the explicit part the rest, so the two add up to ``field``.
 
-    ``J0`` is held out of differentiation: the parts add up to ``field`` whatever the
-    matrix, so the solution depends on it only through the discretisation error, and the
-    derivatives of the run are those of the same scheme with the matrix fixed, a consistent
-    discretisation of the sensitivity equations. Derivatives of ``J0`` would be second
-    derivatives of the field, which multiply the compile time of a gradient."""
+    The parts add up to ``field`` whatever the matrix, so ``J0`` only needs to be close:
+    it is a forward difference (:func:`jaxveh._differences.forward_difference_jacobian`,
+    one copy of the field in the program where ``jax.jacfwd`` compiled in about five times
+    the field's time), and it is held out of differentiation. The solution depends on it
+    only through the discretisation error, and the derivatives of the run are those of the
+    same scheme with the matrix fixed, a consistent discretisation of the sensitivity
+    equations; derivatives of ``J0`` would be second derivatives of the field, which
+    tripled the compile time of a gradient."""
     x0, unravel = ravel_pytree(y0)
-    jacobian = jax.lax.stop_gradient(jax.jacfwd(lambda x: ravel_pytree(field(t0, unravel(x), None))[0])(x0))
+    jacobian = forward_difference_jacobian(lambda x: ravel_pytree(field(t0, unravel(x), None))[0],
+                                           jax.lax.stop_gradient(x0))
+    jacobian = jax.lax.stop_gradient(jacobian)
 
     def implicit(t, y, args):
         return unravel(jacobian @ (ravel_pytree(y)[0] - x0))

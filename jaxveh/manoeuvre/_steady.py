@@ -31,6 +31,7 @@ import optimistix as optx
 from jaxtyping import Array, Float
 
 from .._core import GRAVITY, ParameterError, run_time_checks_off
+from .._differences import DifferenceNewton
 from ..multibody import TimeInputs, rotation_matrix
 from ..vehicle import (
     ConstantSpeed,
@@ -171,7 +172,7 @@ def initial_guess(car, kinds, values) -> Float[Array, " nx"]:
 def _solve(car, model, kinds, values, x0, max_steps):
     n_aux = _n_aux(car)
     args = (car, model, kinds, values, n_aux)
-    solver = optx.Newton(rtol=STEADY_RTOL, atol=STEADY_ATOL)
+    solver = DifferenceNewton(rtol=STEADY_RTOL, atol=STEADY_ATOL)
     sol = optx.root_find(_residual, solver, x0, args, max_steps=max_steps, throw=False)
     return sol.value, sol.result == optx.RESULTS.successful
 
