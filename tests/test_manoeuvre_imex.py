@@ -16,7 +16,6 @@ import pytest
 import scipy.integrate
 
 import jaxveh  # noqa: F401  (float64)
-from jaxveh._differences import forward_difference_jacobian
 from jaxveh.manoeuvre._imex import AffineRootFinder, imex_solver, linearised_split, relinearised_solve
 
 
@@ -57,28 +56,6 @@ def test_linearised_split_adds_up_to_the_field():
         return split.terms[1].vf(0.0, y, None)
 
     assert np.all(np.asarray(jax.jacfwd(implicit_at)(2.0)) == 0.0)
-
-
-def test_forward_difference_jacobian():
-    """Against the exact Jacobian of a smooth map with entries of very different sizes,
-    under ``jit`` and ``vmap``; the step goes to the side it is taken on at a kink."""
-    def fn(x):
-        return jnp.stack([jnp.sin(x[0]) * x[1], 1e4 * x[2] ** 3 + x[0], jnp.exp(1e-3 * x[1]) - x[2]])
-
-    def close(approx, x):
-        # round-off of a forward difference: about 1e-8 of the row's value and largest slope
-        exact = np.asarray(jax.jacfwd(fn)(x))
-        scale = np.maximum(np.abs(exact).max(axis=1), np.abs(np.asarray(fn(x))))
-        assert np.all(np.abs(np.asarray(approx) - exact) <= 1e-7 * scale[:, None])
-
-    x = jnp.asarray([0.3, -200.0, 2.0])
-    close(forward_difference_jacobian(fn, x), x)
-    xs = jnp.stack([x, jnp.asarray([-1.0, 50.0, 1.5])])
-    batched = jax.jit(jax.vmap(lambda xx: forward_difference_jacobian(fn, xx)))(xs)
-    for k in range(2):
-        close(batched[k], xs[k])
-    kink = forward_difference_jacobian(lambda v: jnp.abs(v), jnp.asarray([0.0, -1.0]))
-    np.testing.assert_allclose(kink, np.diag([1.0, -1.0]), rtol=1e-6)
 
 
 def test_imex_matches_radau():
