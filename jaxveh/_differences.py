@@ -25,18 +25,20 @@ from ._linalg import lu_factor, lu_solve
 RELATIVE_STEP = 1.5e-8
 
 
-def forward_difference_jacobian(fn, x: Float[Array, " n"]) -> Float[Array, "m n"]:
+def forward_difference_jacobian(fn, x: Float[Array, " n"], fx=None) -> Float[Array, "m n"]:
     """``d fn / d x`` (m, n) at ``x`` (n,) by forward differences, steps
     ``RELATIVE_STEP * max(|x_j|, 1)`` (each rounded to one the floats represent). One
-    evaluation per column plus one at ``x``, in a ``lax.map``: the program holds ``fn``
-    once. Relative error about 1e-8 where ``fn`` is smooth; across a kink the slope of the
-    side the step goes to."""
+    evaluation per column, plus one at ``x`` unless its value ``fx`` is given, in a
+    ``lax.map``: the program holds ``fn`` once. Relative error about 1e-8 where ``fn`` is
+    smooth; across a kink the slope of the side the step goes to."""
     n = x.shape[0]
     h = (x + RELATIVE_STEP * jnp.maximum(jnp.abs(x), 1.0)) - x
-    # row j < n: x moved along axis j; row n: x itself
-    steps = jnp.concatenate([jnp.diag(h), jnp.zeros((1, n), x.dtype)])
+    steps = jnp.diag(h)
+    if fx is None:  # the last row: x itself
+        steps = jnp.concatenate([steps, jnp.zeros((1, n), x.dtype)])
     values = jax.lax.map(lambda step: fn(x + step), steps)
-    return ((values[:n] - values[n][None, :]) / h[:, None]).T
+    base = values[n] if fx is None else fx
+    return ((values[:n] - base[None, :]) / h[:, None]).T
 
 
 class _NewtonState(eqx.Module):
@@ -66,7 +68,7 @@ class DifferenceNewton(optx.AbstractRootFinder):
         flat, unravel = ravel_pytree(y)
         fx, aux = fn(y, args)
         f_flat = ravel_pytree(fx)[0]
-        jacobian = forward_difference_jacobian(lambda x: ravel_pytree(fn(unravel(x), args)[0])[0], flat)
+        jacobian = forward_difference_jacobian(lambda x: ravel_pytree(fn(unravel(x), args)[0])[0], flat, f_flat)
         step = lu_solve(lu_factor(jacobian), f_flat)
         new = flat - step
         size = jnp.max(jnp.abs(step) / (self.atol + self.rtol * jnp.abs(new)))

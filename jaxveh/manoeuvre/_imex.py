@@ -85,9 +85,8 @@ def linearised_split(field, y0, t0=0.0) -> diffrax.MultiTerm:
     equations; derivatives of ``J0`` would be second derivatives of the field, which
     tripled the compile time of a gradient."""
     x0, unravel = ravel_pytree(y0)
-    jacobian = forward_difference_jacobian(lambda x: ravel_pytree(field(t0, unravel(x), None))[0],
-                                           jax.lax.stop_gradient(x0))
-    jacobian = jax.lax.stop_gradient(jacobian)
+    jacobian = jax.lax.stop_gradient(
+        forward_difference_jacobian(lambda x: ravel_pytree(field(t0, unravel(x), None))[0], x0))
 
     def implicit(t, y, args):
         return unravel(jacobian @ (ravel_pytree(y)[0] - x0))
