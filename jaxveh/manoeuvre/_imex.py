@@ -40,11 +40,19 @@ class _AffineState(eqx.Module):
 
 
 class AffineRootFinder(optx.AbstractRootFinder):
-    """Root finder for an affine function ``fn(y) = A y + b``: the LU factors of ``A`` (the
-    Jacobian at the initial point, by forward mode) and one Newton step, which is exact up to
-    round-off. Only for affine functions: nothing checks the residual afterwards (the
-    implicit part of :func:`linearised_split` is affine by construction)."""
+    """Root finder for an affine function ``fn(y) = A y + b``: the LU factors of ``A`` and
+    one Newton step, which is exact up to round-off. Only for affine functions: nothing
+    checks the residual afterwards (the implicit part of :func:`linearised_split` is affine
+    by construction).
 
+    ``A`` comes from forward mode over every state, or, given ``matrix`` (the ``J`` of an
+    implicit term ``J (y - y0)``), as ``I - s J`` with the scalar ``s`` read from one
+    directional derivative: the stage equations of a diagonally implicit Runge-Kutta method
+    on that term have this form (``s`` = the diagonal coefficient times the step), and
+    pushing every unit vector through ``J`` (a matrix product of the state's size cubed each
+    step) is then not needed."""
+
+    matrix: jax.Array | None = None
     rtol: float = 0.0  # unused: one step is exact (the fields Optimistix's root finders have)
     atol: float = 0.0
     norm: object = optx.max_norm
@@ -53,7 +61,14 @@ class AffineRootFinder(optx.AbstractRootFinder):
         if "init_state" in options:  # Diffrax's Jacobian of an earlier stage of the step
             return options["init_state"]
         flat, unravel = ravel_pytree(y)
-        jacobian = jax.jacfwd(lambda x: ravel_pytree(fn(unravel(x), args)[0])[0])(flat)
+
+        def flat_fn(x):
+            return ravel_pytree(fn(unravel(x), args)[0])[0]
+
+        if self.matrix is None:
+            jacobian = jax.jacfwd(flat_fn)(flat)
+        else:
+            jacobian = _identity_minus_scaled(self.matrix, flat_fn, flat)
         return _AffineState(lu_factor(jacobian), jnp.asarray(0))
 
     def step(self, fn, y, args, options, state, tags):
@@ -71,13 +86,34 @@ class AffineRootFinder(optx.AbstractRootFinder):
         return y, aux, {}
 
 
-def linearised_split(field, y0, t0=0.0) -> diffrax.MultiTerm:
+def _identity_minus_scaled(matrix, fn, x):
+    """The Jacobian ``I - s J`` of an affine ``fn`` at ``x`` (``J`` = ``matrix``), ``s`` by
+    least squares from one directional derivative along a fixed direction with no zero
+    entry (``I`` where ``J`` maps it to zero, so that ``s`` is immaterial)."""
+    probe = jnp.cos(jnp.arange(1.0, x.shape[0] + 1.0))
+    moved = jax.jvp(fn, (x,), (probe,))[1]
+    image = matrix @ probe
+    norm = jnp.dot(image, image)
+    scale = jnp.where(norm > 0.0, jnp.dot(image, probe - moved) / jnp.where(norm > 0.0, norm, 1.0), 0.0)
+    return jnp.eye(x.shape[0], dtype=x.dtype) - scale * matrix
+
+
+def split_jacobian(field, y0, t0=0.0) -> jax.Array:
+    """The matrix ``J0`` of :func:`linearised_split`: the Jacobian of ``field`` over every
+    state (flattened) at ``(t0, y0)``, a forward difference held out of differentiation."""
+    x0, unravel = ravel_pytree(y0)
+    return jax.lax.stop_gradient(
+        forward_difference_jacobian(lambda x: ravel_pytree(field(t0, unravel(x), None))[0], x0))
+
+
+def linearised_split(field, y0, t0=0.0, jacobian=None) -> diffrax.MultiTerm:
     """``(explicit, implicit)`` Diffrax terms of ``field(t, y, args)`` for an IMEX solver:
     the implicit part is the field's linearisation at ``(t0, y0)`` over every state,
     ``J0 (y - y0)``, the explicit part the rest, so the two add up to ``field``.
 
     The parts add up to ``field`` whatever the matrix, so ``J0`` only needs to be close:
-    it is a forward difference (:func:`jaxveh._differences.forward_difference_jacobian`,
+    it is a forward difference (:func:`split_jacobian`; ``jacobian`` gives it instead;
+    :func:`jaxveh._differences.forward_difference_jacobian`,
     one copy of the field in the program where ``jax.jacfwd`` compiled in about five times
     the field's time), and it is held out of differentiation. The solution depends on it
     only through the discretisation error, and the derivatives of the run are those of the
@@ -85,8 +121,7 @@ def linearised_split(field, y0, t0=0.0) -> diffrax.MultiTerm:
     equations; derivatives of ``J0`` would be second derivatives of the field, which
     tripled the compile time of a gradient."""
     x0, unravel = ravel_pytree(y0)
-    jacobian = jax.lax.stop_gradient(
-        forward_difference_jacobian(lambda x: ravel_pytree(field(t0, unravel(x), None))[0], x0))
+    jacobian = split_jacobian(field, y0, t0) if jacobian is None else jacobian
 
     def implicit(t, y, args):
         return unravel(jacobian @ (ravel_pytree(y)[0] - x0))
@@ -97,10 +132,20 @@ def linearised_split(field, y0, t0=0.0) -> diffrax.MultiTerm:
     return diffrax.MultiTerm(diffrax.ODETerm(explicit), diffrax.ODETerm(implicit))
 
 
-def imex_solver() -> diffrax.KenCarp4:
+def imex_solver(matrix=None) -> diffrax.KenCarp4:
     """``KenCarp4`` (4th order, L-stable implicit part) with :class:`AffineRootFinder`, for
-    the terms of :func:`linearised_split`."""
-    return diffrax.KenCarp4(root_finder=AffineRootFinder())
+    the terms of :func:`linearised_split` (``matrix``: their ``J0``, which spares the root
+    finder a forward-mode Jacobian each step)."""
+    return diffrax.KenCarp4(root_finder=AffineRootFinder(matrix=matrix))
+
+
+def _with_matrix(solver, matrix):
+    """``solver`` with its :class:`AffineRootFinder` told the split's matrix (others as
+    they are)."""
+    finder = getattr(solver, "root_finder", None)
+    if isinstance(finder, AffineRootFinder) and finder.matrix is None:
+        return eqx.tree_at(lambda s: s.root_finder, solver, AffineRootFinder(matrix=matrix))
+    return solver
 
 
 class SegmentedSolution(eqx.Module):
@@ -134,20 +179,32 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
     edges = jnp.linspace(0.0, t1, segments + 1)
     n_conditions = len(jax.tree.leaves(event.cond_fn, is_leaf=callable))
     options = {} if adjoint is None else {"adjoint": adjoint}
+    # the solver steps one flat vector (fewer operations per step than a pytree state)
+    x0, unravel = ravel_pytree(y0)
+
+    def flat_field(t, x, args):
+        return ravel_pytree(field(t, unravel(x), args))[0]
+
+    flat_event = eqx.tree_at(lambda e: e.cond_fn, event, jax.tree.map(
+        lambda c: lambda t, x, args, **kw: c(t, unravel(x), args, **kw), event.cond_fn, is_leaf=callable))
 
     def run(y, dt, a, b):
-        terms = linearised_split(field, y, a) if split else diffrax.ODETerm(field)
-        sol = diffrax.diffeqsolve(terms, solver, a, b, dt, y, saveat=diffrax.SaveAt(ts=jnp.clip(ts, a, b), t1=True),
-                                  event=event, stepsize_controller=controller, max_steps=max_steps, throw=False,
+        if split:
+            jacobian = split_jacobian(flat_field, y, a)
+            terms, seg_solver = linearised_split(flat_field, y, a, jacobian), _with_matrix(solver, jacobian)
+        else:
+            terms, seg_solver = diffrax.ODETerm(flat_field), solver
+        sol = diffrax.diffeqsolve(terms, seg_solver, a, b, dt, y, saveat=diffrax.SaveAt(ts=jnp.clip(ts, a, b), t1=True),
+                                  event=flat_event, stepsize_controller=controller, max_steps=max_steps, throw=False,
                                   **options)
         counts = jnp.stack([jnp.asarray(sol.stats[k], jnp.int32) for k in _COUNTS])
         mask = jnp.stack([jnp.asarray(m, bool) for m in jax.tree.leaves(sol.event_mask)])
         status = _status(sol.result).astype(jnp.int32)
-        return jax.tree.map(lambda x: x[:-1], sol.ys), jax.tree.map(lambda x: x[-1], sol.ys), status, mask, counts
+        return sol.ys[:-1], sol.ys[-1], status, mask, counts
 
     def skip(y, dt, a, b):
         del dt, a, b
-        return (jax.tree.map(lambda x: jnp.full(ts.shape + x.shape, jnp.inf, x.dtype), y), y, jnp.asarray(0, jnp.int32),
+        return (jnp.full(ts.shape + y.shape, jnp.inf, y.dtype), y, jnp.asarray(0, jnp.int32),
                 jnp.zeros(n_conditions, bool), jnp.zeros(len(_COUNTS), jnp.int32))
 
     def segment(carry, ab):
@@ -159,13 +216,13 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
 
     dt0 = jnp.asarray(dt0, ts.dtype)
     if segments == 1:  # the plain solve: no loop, no branch
-        ys, _, status, mask, count = run(y0, dt0, edges[0], edges[1])
+        ys, _, status, mask, count = run(x0, dt0, edges[0], edges[1])
         masks, counts = mask[None], count[None]
     else:
-        start = (y0, dt0, jnp.asarray(0, jnp.int32))
+        start = (x0, dt0, jnp.asarray(0, jnp.int32))
         (_, _, status), (ys, masks, counts) = jax.lax.scan(segment, start, (edges[:-1], edges[1:]))
         # each save time from the segment it falls in (the last one holds t1)
         which = jnp.clip(jnp.searchsorted(edges, ts, side="right") - 1, 0, segments - 1)
-        ys = jax.tree.map(lambda x: x[which, jnp.arange(ts.shape[0])], ys)
+        ys = ys[which, jnp.arange(ts.shape[0])]
     stats = {k: counts[:, i].sum() for i, k in enumerate(_COUNTS)} | {"max_steps": max_steps}
-    return SegmentedSolution(ys=ys, status=status, event_mask=tuple(masks.any(axis=0)), stats=stats)
+    return SegmentedSolution(ys=jax.vmap(unravel)(ys), status=status, event_mask=tuple(masks.any(axis=0)), stats=stats)
