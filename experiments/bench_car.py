@@ -6,7 +6,9 @@ IMEX on the fast car, Tsit5 on the library car; ``--solver`` to choose).
 Measures, through the public ``jaxveh.manoeuvre`` API: compile time (the straight-running
 trim plus the run), the run's wall time after compilation (best of three; the trim is
 timed beside it), steps, batches of step steers of different amplitude under ``jax.vmap``
-(sims/s), ``jax.grad`` of the yaw-rate overshoot w.r.t. every leaf of ``CarParams`` over
+(sims/s on the machine's cores: ``jaxveh.map_on_cores``, one vmapped call per core on its
+part of the batch; ``batch_sims_per_s_one_call`` the same batches as one call),
+``jax.grad`` of the yaw-rate overshoot w.r.t. every leaf of ``CarParams`` over
 the same function's forward time, the worst channel's difference from the library car
 (both at rtol 1e-8), the library car's wall time at the fast run's tolerance, and the
 CommonRoad multi-body model (PAC2002 tyres, SciPy RK45, its vehicle 2) through a step of
@@ -166,15 +168,27 @@ def bench(quick: bool, solver: str, log) -> dict:
         f"{res['max_rel_error_vs_library']:.1e}; fast at rtol {RTOL:g} vs that: "
         f"{res['max_rel_error_vs_library_at_rtol']:.1e}")
 
-    res["batch_sims_per_s"], res["batch_compile_s"] = {}, {}
+    res["batch_sims_per_s"], res["batch_sims_per_s_one_call"], res["batch_compile_s"] = {}, {}, {}
+    res["cores"] = jaxveh.core_count()
     batched = eqx.filter_jit(jax.vmap(lambda car, trim, angle, rtol: fast(car, trim, angle, rtol)[0]["yaw_rate"],
                                       in_axes=(None, None, 0, None)))
+
+    def part(angles):
+        return batched(car, trim, angles, rtol)
+
+    def on_cores(angles):
+        return jaxveh.map_on_cores(part, angles)
+
     for n in BATCHES[:2] if quick else BATCHES:
         angles = jnp.linspace(0.5, 1.0, n) * ANGLE
         _, res["batch_compile_s"][str(n)] = _timed(batched, car, trim, angles, rtol)
         wall = _best(batched, car, trim, angles, rtol, repeats=2 if n <= 16 else 1)
+        res["batch_sims_per_s_one_call"][str(n)] = n / wall
+        on_cores(angles)  # the parts' size compiled
+        wall = _best(on_cores, angles, repeats=2 if n <= 16 else 1)
         res["batch_sims_per_s"][str(n)] = n / wall
-        log(f"batch {n}: {n / wall:.2f} sims/s")
+        log(f"batch {n}: {n / wall:.2f} sims/s on {res['cores']} cores "
+            f"({res['batch_sims_per_s_one_call'][str(n)]:.2f} as one call)")
 
     if not quick:
         overshoot = overshoot_fn(car, res["solver"])

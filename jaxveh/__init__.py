@@ -15,5 +15,6 @@ from ._core import (  # noqa: E402
     check_x64 as check_x64,
     run_time_checks_off as run_time_checks_off,
 )
+from ._parallel import core_count as core_count, map_on_cores as map_on_cores  # noqa: E402
 
 __version__ = "0.1.0"
