@@ -25,20 +25,29 @@ from ._linalg import lu_factor, lu_solve
 RELATIVE_STEP = 1.5e-8
 
 
+def _differences(fn, x, with_base: bool):
+    """``(values, h)``: ``fn`` (returning a pytree) at ``x`` plus each step ``h_j e_j``, and at
+    ``x`` itself as the last row when ``with_base``, in one ``lax.map``."""
+    n = x.shape[0]
+    h = (x + RELATIVE_STEP * jnp.maximum(jnp.abs(x), 1.0)) - x
+    steps = jnp.diag(h)
+    if with_base:
+        steps = jnp.concatenate([steps, jnp.zeros((1, n), x.dtype)])
+    return jax.lax.map(lambda step: fn(x + step), steps), h
+
+
+def _quotients(values, base, h):
+    return ((values[: h.shape[0]] - base[None, :]) / h[:, None]).T
+
+
 def forward_difference_jacobian(fn, x: Float[Array, " n"], fx=None) -> Float[Array, "m n"]:
     """``d fn / d x`` (m, n) at ``x`` (n,) by forward differences, steps
     ``RELATIVE_STEP * max(|x_j|, 1)`` (each rounded to one the floats represent). One
     evaluation per column, plus one at ``x`` unless its value ``fx`` is given, in a
     ``lax.map``: the program holds ``fn`` once. Relative error about 1e-8 where ``fn`` is
     smooth; across a kink the slope of the side the step goes to."""
-    n = x.shape[0]
-    h = (x + RELATIVE_STEP * jnp.maximum(jnp.abs(x), 1.0)) - x
-    steps = jnp.diag(h)
-    if fx is None:  # the last row: x itself
-        steps = jnp.concatenate([steps, jnp.zeros((1, n), x.dtype)])
-    values = jax.lax.map(lambda step: fn(x + step), steps)
-    base = values[n] if fx is None else fx
-    return ((values[:n] - base[None, :]) / h[:, None]).T
+    values, h = _differences(fn, x, fx is None)
+    return _quotients(values, values[-1] if fx is None else fx, h)
 
 
 class _NewtonState(eqx.Module):
@@ -66,10 +75,15 @@ class DifferenceNewton(optx.AbstractRootFinder):
     def step(self, fn, y, args, options, state, tags):
         del options, tags
         flat, unravel = ravel_pytree(y)
-        fx, aux = fn(y, args)
-        f_flat = ravel_pytree(fx)[0]
-        jacobian = forward_difference_jacobian(lambda x: ravel_pytree(fn(unravel(x), args)[0])[0], flat, f_flat)
-        step = lu_solve(lu_factor(jacobian), f_flat)
+
+        def flat_fn(x):
+            fx, aux = fn(unravel(x), args)
+            return ravel_pytree(fx)[0], aux
+
+        # the residual at y is the loop's last row: the program holds the function once
+        (values, auxes), h = _differences(flat_fn, flat, with_base=True)
+        f_flat, aux = values[-1], jax.tree.map(lambda a: a[-1], auxes)
+        step = lu_solve(lu_factor(_quotients(values, f_flat, h)), f_flat)
         new = flat - step
         size = jnp.max(jnp.abs(step) / (self.atol + self.rtol * jnp.abs(new)))
         return unravel(new), _NewtonState(size, jnp.max(jnp.abs(f_flat)) / self.atol, state.steps + 1), aux
