@@ -73,9 +73,9 @@ def map_on_cores(fn, batched, cores: int | None = None):
     first = [] if key in _compiled else [call(chunks[0])]
     _compiled.add(key)
     rest = chunks[len(first):]
-    if len(rest) == 1:
-        outs = first + [call(rest[0])]
+    if len(rest) <= 1:
+        outs = first + [call(chunk) for chunk in rest]
     else:
-        with ThreadPoolExecutor(max(len(rest), 1)) as pool:
+        with ThreadPoolExecutor(len(rest)) as pool:
             outs = first + list(pool.map(call, rest))
     return jax.tree.map(lambda *x: np.concatenate(x)[:n], *outs)
