@@ -57,7 +57,8 @@ class _NewtonState(eqx.Module):
 
 
 class DifferenceNewton(optx.AbstractRootFinder):
-    """Newton's method with :func:`forward_difference_jacobian` (a fresh one each step) and
+    """Newton's method with a forward-difference Jacobian (a fresh one each step, the residual
+    at the current point the difference loop's last row) and
     an LU solve that stays unbatched under ``vmap`` (:mod:`jaxveh._linalg`). It stops, as
     Optimistix's ``Newton`` does, when the last step is within ``atol + rtol |y|`` and the
     residual before it within ``atol``. The Jacobian's error (about 1e-8 of its entries)
