@@ -1,6 +1,6 @@
 """Car benchmark (issue 11): the default 6-mode flexible car (2.5 % modal damping), a 5 s
 step steer at 90 km/h, in the fast form (minimal coordinates) against the library car and
-the CommonRoad multi-body model, with ``simulate``'s default solver at rtol 1e-4 (KenCarp4
+the CommonRoad multi-body model, with ``simulate``'s default solver at rtol 1e-4 (KenCarp5
 IMEX on the fast car, Tsit5 on the library car; ``--solver`` to choose).
 
 Measures, through the public ``jaxveh.manoeuvre`` API: compile time (the straight-running

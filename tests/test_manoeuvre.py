@@ -210,7 +210,7 @@ def test_flexible_minus_rigid_agrees(runs):
 
 @pytest.mark.slow
 def test_imex_is_the_default_and_as_accurate_in_fewer_steps(runs):
-    """``simulate``'s default on the fast car at rtol 1e-4 is KenCarp4 IMEX (its linearisation
+    """``simulate``'s default on the fast car at rtol 1e-4 is KenCarp5 IMEX (its linearisation
     at the start implicit, jaxveh.manoeuvre._imex); against the rtol 1e-8 run every channel
     of the 6-mode step steer is within 1e-3 of its largest value (the modal coordinates: of
     theirs), as Tsit5's at the same rtol is, in under 40 % of Tsit5's steps (the chassis
@@ -219,7 +219,7 @@ def test_imex_is_the_default_and_as_accurate_in_fewer_steps(runs):
     reference = _channels(runs[6, "fast"])
     imex = simulate(car, step_steer(angle=ANGLE))
     explicit = simulate(car, step_steer(angle=ANGLE), solver="tsit5")
-    assert imex.solver == "kencarp4" and explicit.solver == "tsit5" and runs[6, "fast"].solver == "tsit5"
+    assert imex.solver == "kencarp5" and explicit.solver == "tsit5" and runs[6, "fast"].solver == "tsit5"
     for run in (imex, explicit):
         assert run.stop_reason == "completed"
         for name, value in _channels(run).items():
@@ -347,7 +347,7 @@ def test_a_spinning_car_stops_with_the_event_named(runs, form, rtol):
     1e-6 the compiled programs of the fixture's rigid runs serve (speed and steer are
     traced); at 1e-4 the fast car runs IMEX in segments (the later ones skipped)."""
     run = simulate(load_car(modes=0), step_steer(speed=35.0, angle=1.5), form=form, rtol=rtol, throw=False)
-    assert run.solver == ("kencarp4" if rtol == 1e-4 else "tsit5")
+    assert run.solver == ("kencarp5" if rtol == 1e-4 else "tsit5")
     assert int(run.status) == 1 and run.stop_reason.startswith("spin after t = ")
     valid = np.asarray(run.valid)
     assert 0 < valid.sum() < valid.size and not valid[-1]

@@ -49,6 +49,7 @@ from ._road import (
 from ._simulate import (
     AUTO_IMEX_RTOL as AUTO_IMEX_RTOL,
     EVENTS as EVENTS,
+    IMEX_SOLVERS as IMEX_SOLVERS,
     SOLVERS as SOLVERS,
     CarRun as CarRun,
     manoeuvre_channels as manoeuvre_channels,

@@ -3,7 +3,7 @@
 The car's vector field is split into a linear part taken implicitly, its Jacobian at the
 start ``J0 (x - x0)`` over every state (a forward difference, held out of
 differentiation), and the rest, ``f(x) - J0 (x - x0)``, taken explicitly by Diffrax's
-additive Runge-Kutta method ``KenCarp4``; the two parts add up to the exact vector field.
+additive Runge-Kutta method ``KenCarp5`` (or ``KenCarp4``); the two parts add up to the exact vector field.
 The stiff motions of the car (the chassis modes at up to 525 rad/s, the tyres' relaxation
 at speed / relaxation length, wheel hop and wheel spin) are close to linear about the
 start, so the explicit remainder is no longer stiff and the step follows the manoeuvre.
@@ -11,12 +11,13 @@ start, so the explicit remainder is no longer stiff and the step follows the man
 As the car turns away from the state it was linearised at, the remainder grows stiff again
 and the steps shrink (the benchmark step steer: 45 steps of 44 ms over its last 2 s).
 :func:`relinearised_solve` therefore cuts the run into equal time segments and linearises
-again at the start of each, one compiled segment solve in a ``lax.scan``; three segments
-take the step steer from 274 to about 210 steps (docs/manoeuvre.md, "Speed").
+again at the start of each, one compiled segment solve in a ``lax.scan``: with KenCarp4
+three segments took the step steer from 274 to about 210 steps, with KenCarp5 four take it
+in about 140 (docs/manoeuvre.md, "Speed").
 
 The implicit stage equations are then affine in the unknown, so one Newton step solves
 them exactly: :class:`AffineRootFinder` factorises their Jacobian once per step (Diffrax
-computes it at the second stage and reuses it for the others, ``KenCarp4`` having one
+computes it at the second stage and reuses it for the others, both methods having one
 diagonal coefficient) and takes one step per stage, where Optimistix's Newton would
 re-linearise and iterate to a tolerance, and Diffrax's chord method (``VeryChord``) was
 seen to reject tens of thousands of steps at rtol 1e-4 on this car.
@@ -132,11 +133,18 @@ def linearised_split(field, y0, t0=0.0, jacobian=None) -> diffrax.MultiTerm:
     return diffrax.MultiTerm(diffrax.ODETerm(explicit), diffrax.ODETerm(implicit))
 
 
-def imex_solver(matrix=None) -> diffrax.KenCarp4:
-    """``KenCarp4`` (4th order, L-stable implicit part) with :class:`AffineRootFinder`, for
-    the terms of :func:`linearised_split` (``matrix``: their ``J0``, which spares the root
-    finder a forward-mode Jacobian each step)."""
-    return diffrax.KenCarp4(root_finder=AffineRootFinder(matrix=matrix))
+#: The additive Runge-Kutta methods :func:`imex_solver` builds, by name.
+IMEX_METHODS = {"kencarp5": diffrax.KenCarp5, "kencarp4": diffrax.KenCarp4}
+
+
+def imex_solver(matrix=None, method: str = "kencarp5") -> diffrax.AbstractSolver:
+    """``KenCarp5`` (5th order, 8 stages; or ``"kencarp4"``: 4th order, 6 stages; both with an
+    L-stable implicit part) with :class:`AffineRootFinder`, for the terms of
+    :func:`linearised_split` (``matrix``: their ``J0``, which spares the root finder a
+    forward-mode Jacobian each step)."""
+    if method not in IMEX_METHODS:
+        raise ValueError(f"method = {method!r} is not an IMEX method: allowed {', '.join(map(repr, IMEX_METHODS))}")
+    return IMEX_METHODS[method](root_finder=AffineRootFinder(matrix=matrix))
 
 
 def _with_matrix(solver, matrix):

@@ -43,21 +43,22 @@ from ._imex import imex_solver, relinearised_solve
 from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
 
-#: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; KenCarp4 IMEX (the fast
-#: car: its linearisation implicit, taken again in each of :data:`LINEARISATIONS` time
-#: segments, :mod:`._imex`; the library car: its chassis
-#: modes' forces implicit); the fully implicit Kvaerno5.
-SOLVERS = ("tsit5", "kencarp4", "kvaerno5")
-#: ``solver="auto"`` (the default of :func:`simulate`) takes KenCarp4 on the fast car from this
-#: rtol up (2-3 times faster than Tsit5 at 1e-4 and 1e-3, about equal at 1e-6) and Tsit5 below
-#: it and on the library car (docs/manoeuvre.md, "Solvers").
+#: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; the IMEX KenCarp5 and
+#: KenCarp4 (the fast car: its linearisation implicit, taken again in each of
+#: :data:`LINEARISATIONS` time segments, :mod:`._imex`; the library car: its chassis modes'
+#: forces implicit); the fully implicit Kvaerno5.
+SOLVERS = ("tsit5", "kencarp5", "kencarp4", "kvaerno5")
+#: The additive Runge-Kutta (IMEX) solvers of :data:`SOLVERS`.
+IMEX_SOLVERS = ("kencarp5", "kencarp4")
+#: ``solver="auto"`` (the default of :func:`simulate`) takes KenCarp5 on the fast car from this
+#: rtol up (2-3 times faster than Tsit5 at 1e-4 and 1e-3) and Tsit5 below it and on the
+#: library car (docs/manoeuvre.md, "Solvers").
 AUTO_IMEX_RTOL = 1e-5
-#: Linearisations of the fast car's IMEX split per run (KenCarp4 only): the run is cut into
-#: this many equal time segments, each linearised at its start (:func:`._imex.relinearised_solve`).
-#: On the benchmark step steer (5 s, rtol 1e-4) 1 / 2 / 3 / 4 / 5 / 10 of them take 274 / 229
-#: / 211 / 197 / 201 / 221 steps in 0.23 / 0.17 / 0.15 / 0.16 / 0.16 / 0.20 s: each costs a
-#: Jacobian (about 2-4 ms) and a restart (docs/manoeuvre.md, "Speed").
-LINEARISATIONS = 3
+#: Linearisations of the fast car's IMEX split per run: the run is cut into this many equal
+#: time segments, each linearised at its start (:func:`._imex.relinearised_solve`). On the
+#: benchmark step steer (5 s, rtol 1e-4) KenCarp5 with 3 / 4 / 5 of them takes 155 / 141 / 146
+#: steps; each costs a Jacobian (about 2-4 ms) and a restart (docs/manoeuvre.md, "Speed").
+LINEARISATIONS = 4
 #: First step (s): given rather than estimated, which would compile two more copies of the
 #: vector field; the controller adapts it from the first step on.
 FIRST_STEP = 1e-3
@@ -95,14 +96,15 @@ class CarRun(eqx.Module):
 def _solver(name: str, form: str = "library"):
     if name == "tsit5":
         return diffrax.Tsit5()
-    if name == "kencarp4" and form == "fast":
-        return imex_solver()
-    if name in ("kencarp4", "kvaerno5"):
+    if name in IMEX_SOLVERS and form == "fast":
+        return imex_solver(method=name)
+    if name in IMEX_SOLVERS or name == "kvaerno5":
         import optimistix as optx
 
         # Newton, not Diffrax's default chord iteration (far more steps on this problem)
         newton = optx.Newton(rtol=1e-8, atol=1e-10)
-        return diffrax.KenCarp4(root_finder=newton) if name == "kencarp4" else diffrax.Kvaerno5(root_finder=newton)
+        return {"kencarp5": diffrax.KenCarp5, "kencarp4": diffrax.KenCarp4, "kvaerno5": diffrax.Kvaerno5}[name](
+            root_finder=newton)
     raise ParameterError(f"solver = {name!r} is not available: allowed 'auto', {', '.join(map(repr, SOLVERS))}")
 
 
@@ -112,7 +114,7 @@ def pick_solver(solver: str, form: str, rtol: float) -> str:
     if solver != "auto":
         _solver(solver)
         return solver
-    return "kencarp4" if form == "fast" and rtol >= AUTO_IMEX_RTOL else "tsit5"
+    return "kencarp5" if form == "fast" and rtol >= AUTO_IMEX_RTOL else "tsit5"
 
 
 class _Driving(eqx.Module):
@@ -168,10 +170,10 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps,
     # the states at the save times (dense output), then the channels in one vectorised pass:
     # a save function would be traced five times by Diffrax and sit inside the step loop
     sol = relinearised_solve(
-        field, s0, manoeuvre.duration, ts, segments=linearisations if solver == "kencarp4" else 1,
+        field, s0, manoeuvre.duration, ts, segments=linearisations if solver in IMEX_SOLVERS else 1,
         controller=diffrax.PIDController(rtol=rtol, atol=atol, jump_ts=kink_times(manoeuvre)),
         event=diffrax.Event(conditions), dt0=FIRST_STEP, max_steps=max_steps, adjoint=adjoint,
-        solver=_solver(solver, "fast"), split=solver == "kencarp4")
+        solver=_solver(solver, "fast"), split=solver in IMEX_SOLVERS)
     rolled, spun = sol.event_mask
     valid = jnp.isfinite(sol.ys.q[:, 0])  # Diffrax fills the save times after a stop with inf
     states = jax.tree.map(lambda x: _hold_after_stop(x, valid), sol.ys)
@@ -217,7 +219,7 @@ def _library(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_ste
     sim = mb.simulate(car.system, system_params(car), trim.static.q, trim.z, 0.0, manoeuvre.duration, ts,
                       inputs=law, elements=elements, aux0=aux0, outputs=outputs, solver=_solver(solver),
                       rtol=rtol, atol=atol, dt0=FIRST_STEP, max_steps=max_steps, jump_ts=kink_times(manoeuvre),
-                      implicit_modes=solver == "kencarp4", freeze_steps=freeze_steps, throw=False,
+                      implicit_modes=solver in IMEX_SOLVERS, freeze_steps=freeze_steps, throw=False,
                       events={"rollover": lambda t, st: rolled(st), "spin": lambda t, st: spun(st)})
     event = jnp.where(sim.status == 1, _event_code(rolled(sim.final), spun(sim.final)), 0)
     return sim.outputs, dict(sim.stats) | {"event": event, "valid": sim.valid}, sim.status
@@ -235,7 +237,7 @@ def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, s
     ``status``: 0 completed, 1 stopped by an event, 2 solver failure. ``freeze_steps``
     (library form): hold the projection matrices for that many steps
     (:class:`jaxveh.multibody.ProjectedSolver`; 0: exact). ``linearisations`` (fast form,
-    KenCarp4): time segments of the run, each with the IMEX split linearised at its start
+    IMEX solvers): time segments of the run, each with the IMEX split linearised at its start
     (:data:`LINEARISATIONS`; 1: once, at the start); ``max_steps`` holds per segment."""
     run = _fast if check_form(form) == "fast" else _library
     _check_freeze_steps(freeze_steps, form)
@@ -321,7 +323,7 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     :class:`CarRun` with ``points`` save times. ``form``: "fast" or "library" (default: the
     car's own, ``car.form``). ``rtol``/``atol``: the PID step-size controller's tolerances
     (default ``atol = rtol / 100`` on every state: metres, radians, modal coordinates).
-    ``solver``: one of :data:`SOLVERS`, or "auto" (:func:`pick_solver`: KenCarp4 IMEX on the
+    ``solver``: one of :data:`SOLVERS`, or "auto" (:func:`pick_solver`: KenCarp5 IMEX on the
     fast car from rtol :data:`AUTO_IMEX_RTOL` up, else Tsit5); the run's is ``CarRun.solver``.
     A run stops early when the car rolls over or spins (:data:`EVENTS`; ``status`` 1,
     ``stop_reason`` names the event and its time). A failed solve raises ``RuntimeError``
