@@ -268,3 +268,27 @@ def test_derivatives_through_the_imex_solve():
     _, forward = jax.jvp(lambda x: _pendulum_end(x, diffrax.ForwardMode()), (g,), (1.0,))
     np.testing.assert_allclose(reverse, fd, rtol=1e-6)
     np.testing.assert_allclose(forward, fd, rtol=1e-6)
+
+
+def test_solver_names():
+    """``pick_solver``: "auto" takes KenCarp5 on the fast car from AUTO_IMEX_RTOL up and Tsit5
+    below it and on the library car; each name builds its solver (the fast car's IMEX with
+    the affine root finder, the library car's with Optimistix's Newton); an unknown name is
+    refused with the allowed ones."""
+    from jaxveh.manoeuvre import AUTO_IMEX_RTOL, IMEX_SOLVERS, SOLVERS, pick_solver
+    from jaxveh.manoeuvre._imex import AffineRootFinder
+    from jaxveh.manoeuvre._simulate import _solver
+
+    assert pick_solver("auto", "fast", 1e-4) == "kencarp5" and pick_solver("auto", "fast", AUTO_IMEX_RTOL) == "kencarp5"
+    assert pick_solver("auto", "fast", 0.5 * AUTO_IMEX_RTOL) == "tsit5"
+    assert pick_solver("auto", "library", 1e-4) == "tsit5"
+    assert set(IMEX_SOLVERS) <= set(SOLVERS)
+    for name in SOLVERS:
+        assert pick_solver(name, "library", 1e-4) == name
+    for name, cls in (("kencarp5", diffrax.KenCarp5), ("kencarp4", diffrax.KenCarp4)):
+        fast, library = _solver(name, "fast"), _solver(name, "library")
+        assert type(fast) is cls and isinstance(fast.root_finder, AffineRootFinder)
+        assert type(library) is cls and isinstance(library.root_finder, optx.Newton)
+    with pytest.raises(jaxveh.ParameterError, match="solver = 'rk4' is not available: allowed 'auto', 'tsit5', "
+                                                   "'kencarp5', 'kencarp4', 'kvaerno5'"):
+        pick_solver("rk4", "fast", 1e-4)
