@@ -48,14 +48,35 @@ from ._fast_suspension import split_suspensions, suspension_forces
 _EY = ((0.0, 1.0, 0.0),)  # the spin axis, as a row
 
 
+class PointTables(eqx.Module):
+    """The points' design data, stacked once per model (the equations read them at every
+    evaluation; stacked there, a gradient would gather each point's cotangent at every
+    stage): chassis points' positions ``chassis`` (n, 3), translational and rotational mode
+    shapes times the coupling factor (n, 3, modes), rack directions ``inputs`` (n, 3; zero
+    where the rack does not move the point); upright and wheel points' positions in their
+    body frames (m)."""
+
+    chassis: Float[Array, "nc 3"]
+    shapes: Float[Array, "nc 3 nm"]
+    rotation_shapes: Float[Array, "nc 3 nm"]
+    inputs: Float[Array, "nc 3"]
+    upright: Float[Array, "nu 3"]
+    wheel: Float[Array, "nw 3"]
+
+
 class FastModel(eqx.Module):
     """What the fast car's equations read, rebuilt from :class:`CarParams` by JAX operations:
-    the library parameters, the corners' link geometry and the kinematic map (the Newton
-    guess)."""
+    the library parameters, the corners' link geometry, the kinematic map (the Newton
+    guess), the points' stacked design data and the corners' upright masses (kg), inertias
+    (kg m^2, upright axes) and wheel spin inertias (kg m^2)."""
 
     params: SystemParams
     geometry: CornerGeometry
     kmap: KinematicMap
+    points: PointTables
+    upright_mass: Float[Array, "4"]
+    upright_inertia: Float[Array, "4 3 3"]
+    spin_inertia: Float[Array, "4"]
 
 
 class FastState(eqx.Module):
@@ -71,7 +92,12 @@ def fast_model(car: Car) -> FastModel:
     """The fast car's model of ``car.params`` (differentiable; builds the kinematic map)."""
     params = system_params(car)
     geometry = corner_geometry(car.system, params, wheel_centres(car.params.vehicle))
-    return FastModel(params=params, geometry=geometry, kmap=build_map(geometry))
+    lay = _layout(car)
+    return FastModel(params=params, geometry=geometry, kmap=build_map(geometry),
+                     points=_point_tables(car, params, lay),
+                     upright_mass=jnp.stack([params.bodies[i].mass for i in lay["uprights"]]),
+                     upright_inertia=jnp.stack([params.bodies[i].inertia for i in lay["uprights"]]),
+                     spin_inertia=jnp.stack([params.bodies[i].inertia[1, 1] for i in lay["wheels"]]))
 
 
 def split(car: Car, x):
@@ -207,7 +233,7 @@ def _bias(m: CarMotion, vc, travel_rate):
 # ---- kinematics for the force elements --------------------------------------------------------
 
 
-def _point_tables(car: Car, params: SystemParams, lay):
+def _point_tables(car: Car, params: SystemParams, lay) -> PointTables:
     pts = params.points
     ch = lay["chassis_points"]
     local = jnp.stack([pts[k].position for k in ch])
@@ -218,13 +244,15 @@ def _point_tables(car: Car, params: SystemParams, lay):
     inputs = jnp.stack([pts[k].input_direction * float(car.system.point_input[k] >= 0) for k in ch])
     up = jnp.stack([pts[k].position for k in lay["upright_points"]])
     wh = jnp.stack([pts[k].position for k in lay["wheel_points"]])
-    return local, coupling * shapes, coupling * rshapes, inputs, up, wh
+    return PointTables(chassis=local, shapes=coupling * shapes, rotation_shapes=coupling * rshapes, inputs=inputs,
+                       upright=up, wheel=wh)
 
 
 def _point_kinematics(car, model, lay, m: CarMotion, q, rack):
     """Positions and material orientations of every point (library order)."""
     qc = split(car, q)[0]
-    local, shapes, rshapes, inputs, up, wh = _point_tables(car, model.params, lay)
+    pt = model.points
+    local, shapes, rshapes, inputs, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.inputs, pt.upright, pt.wheel
     modes = qc[6:]
     x_ch = local + shapes @ modes + rack * inputs
     a_up = _mm(m.a_c[None], m.a_rel)
@@ -245,7 +273,8 @@ def _point_kinematics(car, model, lay, m: CarMotion, q, rack):
 def _point_rates(car, model, lay, m: CarMotion, velocity, a_up, q):
     """Velocities and angular velocities (global axes) of every point, linear in the body
     velocities ``velocity`` (plus the rack rate through ``velocity``)."""
-    local, shapes, rshapes, inputs, up, wh = _point_tables(car, model.params, lay)
+    pt = model.points
+    local, shapes, rshapes, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.upright, pt.wheel
     qc = split(car, q)[0]
     vc, v_up, w_up, w_wheel = velocity
     x_ch = local + shapes @ qc[6:]
@@ -273,7 +302,8 @@ def _applied_wrenches(car, model, lay, m: CarMotion, a_up, q, rack, forces, torq
     translational and rotational mode shapes) and, per corner, the upright's force and
     moment about its centre and the wheel's moment about its hub (upright axes; the wheel's
     force is the upright's). The point-velocity Jacobian transposed, body by body."""
-    local, shapes, rshapes, inputs, up, wh = _point_tables(car, model.params, lay)
+    pt = model.points
+    local, shapes, rshapes, inputs, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.inputs, pt.upright, pt.wheel
     ch = lay["chassis_points"]
     x_ch = local + shapes @ q[6:6 + car.n_modes] + rack * inputs
     f_ch, t_ch = _mv(m.a_c.T[None], forces[ch]), _mv(m.a_c.T[None], torques[ch])
@@ -423,9 +453,7 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     quad_el, grav = body_forces(system, params, 0, (m.r_c, m.a_c, q[6:6 + car.n_modes]), vc)
     q_chassis, (f_ap, t_ap, t_ap_wh) = _applied_wrenches(car, model, lay, m, a_up, q, rack, forces, torques)
     _, v_up, w_up, w_wheel = m.velocity
-    mass = jnp.stack([params.bodies[i].mass for i in lay["uprights"]])
-    inertia = jnp.stack([params.bodies[i].inertia for i in lay["uprights"]])
-    spin = jnp.stack([params.bodies[i].inertia[1, 1] for i in lay["wheels"]])
+    mass, inertia, spin = model.upright_mass, model.upright_inertia, model.spin_inertia
     g_up = _mv(jnp.swapaxes(_mm(m.a_c[None], m.a_rel), 1, 2), params.gravity[None, :])
     # uprights: m (v_dot + w x v) = F, J w_dot + w x J w = T (c.g. at the wheel centre)
     f_up = mass[:, None] * (g_up - v_acc - jnp.cross(w_up, v_up))
