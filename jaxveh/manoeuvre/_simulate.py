@@ -39,7 +39,7 @@ from ..vehicle import (
 from ..vehicle._setup import CHASSIS_FORWARD, CHASSIS_LATERAL
 from ._channels import UNITS, car_channels
 from ._driver import AbstractSteeringLaw, Manoeuvre, kink_times
-from ._imex import imex_solver, relinearised_solve
+from ._imex import IMEX_METHODS, imex_solver, relinearised_solve
 from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
 
@@ -49,7 +49,7 @@ from ._steady import compiled_core, condition_kinds, steady_state_core
 #: forces implicit); the fully implicit Kvaerno5.
 SOLVERS = ("tsit5", "kencarp5", "kencarp4", "kvaerno5")
 #: The additive Runge-Kutta (IMEX) solvers of :data:`SOLVERS`.
-IMEX_SOLVERS = ("kencarp5", "kencarp4")
+IMEX_SOLVERS = tuple(IMEX_METHODS)
 #: ``solver="auto"`` (the default of :func:`simulate`) takes KenCarp5 on the fast car from this
 #: rtol up (2-3 times faster than Tsit5 at 1e-4 and 1e-3) and Tsit5 below it and on the
 #: library car (docs/manoeuvre.md, "Solvers").
@@ -103,8 +103,7 @@ def _solver(name: str, form: str = "library"):
 
         # Newton, not Diffrax's default chord iteration (far more steps on this problem)
         newton = optx.Newton(rtol=1e-8, atol=1e-10)
-        return {"kencarp5": diffrax.KenCarp5, "kencarp4": diffrax.KenCarp4, "kvaerno5": diffrax.Kvaerno5}[name](
-            root_finder=newton)
+        return (IMEX_METHODS | {"kvaerno5": diffrax.Kvaerno5})[name](root_finder=newton)
     raise ParameterError(f"solver = {name!r} is not available: allowed 'auto', {', '.join(map(repr, SOLVERS))}")
 
 
