@@ -21,6 +21,15 @@ computes it at the second stage and reuses it for the others, both methods havin
 diagonal coefficient) and takes one step per stage, where Optimistix's Newton would
 re-linearise and iterate to a tolerance, and Diffrax's chord method (``VeryChord``) was
 seen to reject tens of thousands of steps at rtol 1e-4 on this car.
+
+Some states are left out of the implicit part (``explicit``: their columns of ``J0`` are
+zero, so the field's dependence on them stays whole in the explicit part): the car's
+position and heading on the ground. The car's equations do not depend on them, except
+through a closed-loop driver's path or a road, and there they are neither stiff nor close
+to linear over a run (a car on a skid-pad goes round the circle). Linearised, their
+columns put a term ``J0 (x - x0)`` into the stiff rows that grows with the distance
+travelled, is cancelled by the explicit part, and held the closed-loop skid-pad's steps
+near 9 ms where 35 ms hold its accuracy (docs/manoeuvre.md, "Speed").
 """
 
 import diffrax
@@ -99,18 +108,23 @@ def _identity_minus_scaled(matrix, fn, x):
     return jnp.eye(x.shape[0], dtype=x.dtype) - scale * matrix
 
 
-def split_jacobian(field, y0, t0=0.0) -> jax.Array:
+def split_jacobian(field, y0, t0=0.0, explicit: tuple[int, ...] = ()) -> jax.Array:
     """The matrix ``J0`` of :func:`linearised_split`: the Jacobian of ``field`` over every
-    state (flattened) at ``(t0, y0)``, a forward difference held out of differentiation."""
+    state (flattened) at ``(t0, y0)``, a forward difference held out of differentiation,
+    with zero columns at the flat indices ``explicit`` (states kept explicit, see the
+    module docs)."""
     x0, unravel = ravel_pytree(y0)
-    return jax.lax.stop_gradient(
-        forward_difference_jacobian(lambda x: ravel_pytree(field(t0, unravel(x), None))[0], x0))
+    jacobian = forward_difference_jacobian(lambda x: ravel_pytree(field(t0, unravel(x), None))[0], x0)
+    if explicit:
+        jacobian = jacobian.at[:, jnp.asarray(explicit)].set(0.0)
+    return jax.lax.stop_gradient(jacobian)
 
 
-def linearised_split(field, y0, t0=0.0, jacobian=None) -> diffrax.MultiTerm:
+def linearised_split(field, y0, t0=0.0, jacobian=None, explicit: tuple[int, ...] = ()) -> diffrax.MultiTerm:
     """``(explicit, implicit)`` Diffrax terms of ``field(t, y, args)`` for an IMEX solver:
-    the implicit part is the field's linearisation at ``(t0, y0)`` over every state,
-    ``J0 (y - y0)``, the explicit part the rest, so the two add up to ``field``.
+    the implicit part is the field's linearisation at ``(t0, y0)`` over every state but the
+    flat indices ``explicit`` (module docs), ``J0 (y - y0)``, the explicit part the rest, so
+    the two add up to ``field``.
 
     The parts add up to ``field`` whatever the matrix, so ``J0`` only needs to be close:
     it is a forward difference (:func:`split_jacobian`; ``jacobian`` gives it instead;
@@ -122,15 +136,15 @@ def linearised_split(field, y0, t0=0.0, jacobian=None) -> diffrax.MultiTerm:
     equations; derivatives of ``J0`` would be second derivatives of the field, which
     tripled the compile time of a gradient."""
     x0, unravel = ravel_pytree(y0)
-    jacobian = split_jacobian(field, y0, t0) if jacobian is None else jacobian
+    jacobian = split_jacobian(field, y0, t0, explicit) if jacobian is None else jacobian
 
-    def implicit(t, y, args):
+    def implicit_part(t, y, args):
         return unravel(jacobian @ (ravel_pytree(y)[0] - x0))
 
-    def explicit(t, y, args):
-        return jax.tree.map(jnp.subtract, field(t, y, args), implicit(t, y, args))
+    def explicit_part(t, y, args):
+        return jax.tree.map(jnp.subtract, field(t, y, args), implicit_part(t, y, args))
 
-    return diffrax.MultiTerm(diffrax.ODETerm(explicit), diffrax.ODETerm(implicit))
+    return diffrax.MultiTerm(diffrax.ODETerm(explicit_part), diffrax.ODETerm(implicit_part))
 
 
 #: The additive Runge-Kutta methods :func:`imex_solver` builds, by name.
@@ -172,11 +186,13 @@ _COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
 
 
 def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, dt0, max_steps: int,
-                       adjoint=None, solver=None, split: bool = True) -> SegmentedSolution:
+                       adjoint=None, solver=None, split: bool = True,
+                       explicit: tuple[int, ...] = ()) -> SegmentedSolution:
     """Integrate ``field(t, y, args)`` from ``y0`` at t = 0 to ``t1`` (s), saving at ``ts``
     (s, in [0, t1]) by Diffrax's dense output, in ``segments`` equal time segments. With
     ``split`` each segment integrates :func:`linearised_split` at its own start state
-    (``solver`` default :func:`imex_solver`); without it ``field`` itself (``solver`` default
+    (``explicit``: the flat indices of the states it keeps explicit; ``solver`` default
+    :func:`imex_solver`); without it ``field`` itself (``solver`` default
     Tsit5). A segment starts with the mean accepted step of the one before (``dt0`` the
     first); ``controller``, ``event``, ``max_steps`` (per segment) and ``adjoint`` go to
     every segment's ``diffeqsolve``. After a stop (an event or a failure) the later segments
@@ -198,7 +214,7 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
 
     def run(y, dt, a, b):
         if split:
-            jacobian = split_jacobian(flat_field, y, a)
+            jacobian = split_jacobian(flat_field, y, a, explicit)
             terms, seg_solver = linearised_split(flat_field, y, a, jacobian), _with_matrix(solver, jacobian)
         else:
             terms, seg_solver = diffrax.ODETerm(flat_field), solver
