@@ -25,13 +25,14 @@ import gc
 import os
 import signal
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
 
 import jax
 import pytest
-from _watchdog import Watchdog
+from _watchdog import Watchdog, overrun_record
 from jax import monitoring
 
 import jaxveh  # noqa: F401  (enables float64)
@@ -94,8 +95,17 @@ MODULE_SECONDS = {
 #: hour on a cold cache, so the deadline alone does not bound the suite (a CI run was
 #: stopped at 90 minutes with one worker inside a test it had started before the deadline).
 #: A plain ``pytest`` run has no deadline.
+#: A test inside compiled code (an XLA compilation, a deadlock) runs no Python signal
+#: handler, so one still running ``KILL_GRACE`` seconds later (``$JAXVEH_TEST_KILL_GRACE``;
+#: 120) has its worker ended by the watchdog (:mod:`_watchdog`) and is reported as skipped
+#: (:func:`pytest_handlecrashitem`).
 _DEADLINE = float(os.environ.get("JAXVEH_TEST_DEADLINE") or "inf")
 ABANDON_AFTER = float(os.environ.get("JAXVEH_TEST_ABANDON_AFTER") or 15 * 60)
+KILL_GRACE = float(os.environ.get("JAXVEH_TEST_KILL_GRACE") or 120)
+#: Where workers leave word of the tests they ended (shared with pytest-xdist's controller,
+#: which sets it before it starts the workers).
+_RECORDS = Path(os.environ.setdefault(
+    "JAXVEH_TEST_RECORDS", os.path.join(tempfile.gettempdir(), f"jaxveh-test-records-{os.getpid()}-{time.time_ns()}")))
 _HEAVY_MODULES = {name for name, seconds in MODULE_SECONDS.items() if seconds >= 200}
 _current_test = ["(collection)"]
 _in_setup_or_call = [False]
@@ -157,14 +167,68 @@ def pytest_runtest_protocol(item, nextitem):
     the process that runs it (never in pytest-xdist's controller, whose process tree holds
     every worker)."""
     if not _watchdog and Path("/proc/self/stat").exists():
-        _watchdog.append(Watchdog())
+        _watchdog.append(Watchdog(record_dir=_RECORDS))
+    end_by = _DEADLINE + ABANDON_AFTER + KILL_GRACE if _is_long(item) else float("inf")
     for w in _watchdog:
-        w.start_test(item.nodeid)
+        w.start_test(item.nodeid, end_by=end_by)
     try:
         return (yield)
     finally:
         for w in _watchdog:
             w.end_test()
+
+
+def _crash_count(nodeid: str) -> int:
+    """How many times test ``nodeid`` has crashed its worker so far in this run (and count this one)."""
+    counter = overrun_record(_RECORDS, nodeid).with_suffix(".crashes")
+    count = int(counter.read_text()) if counter.exists() else 0
+    counter.parent.mkdir(parents=True, exist_ok=True)
+    counter.write_text(str(count + 1))
+    return count
+
+
+def _drop_finished_modules(sched, also: str | None = None) -> None:
+    """pytest-xdist 3.8's ``--dist loadfile`` puts every module the crashed worker had, its
+    finished ones included, back in the queue; a fresh worker handed a finished one gets an
+    empty batch and waits forever, and so does the run (a CI run ended at its 90 minutes
+    so). Drop the finished ones; ``also``: a test to count as finished (not run again)."""
+    queue = getattr(sched, "workqueue", None)
+    if queue is None:
+        return
+    for tests in queue.values():
+        if also in tests:
+            tests[also] = True
+    for scope in [scope for scope, tests in queue.items() if all(tests.values())]:
+        del queue[scope]
+
+
+@pytest.hookimpl(optionalhook=True, trylast=True)
+def pytest_handlecrashitem(crashitem, report, sched):
+    """pytest-xdist's controller, on a test whose worker died: a test the watchdog ended past
+    the deadline is reported as skipped. Any other crash (XLA's CPU compiler has segfaulted
+    twice in long runs, in two unrelated tests, never reproducibly; a deadlock ended by the
+    watchdog) is reported as a rerun the first time, as the test is run again in a fresh
+    worker (``--dist loadfile`` hands the crashed module's unfinished tests, that one
+    included, to the new worker), and as a failure the second time."""
+    path = report.location[0] if report.location else crashitem.split("::")[0]
+    first_crash = _crash_count(crashitem) == 0
+    if overrun_record(_RECORDS, crashitem).exists():
+        _drop_finished_modules(sched, also=crashitem)
+        report.outcome = "skipped"
+        report.longrepr = (path, None, "Skipped: abandoned: still running past the suite's deadline "
+                           "($JAXVEH_TEST_DEADLINE, set by .ci/run) inside compiled code; its worker was ended")
+    elif first_crash and hasattr(sched, "workqueue"):  # xdist's LoadScope schedulers requeue it
+        _drop_finished_modules(sched)
+        report.outcome = "rerun"
+    else:
+        _drop_finished_modules(sched, also=crashitem)
+
+
+def pytest_report_teststatus(report, config):
+    """A crashed test that runs again (:func:`pytest_handlecrashitem`): ``R``."""
+    if report.outcome == "rerun":
+        return "rerun", "R", ("RERUN", {"yellow": True})
+    return None
 
 
 def _within_setup_or_call():
