@@ -8,7 +8,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxveh._linalg import diagonalise, lu_factor, lu_solve
+from jaxveh._linalg import lu_factor, lu_solve
 
 RNG = np.random.default_rng(3)
 N = 6
@@ -64,23 +64,3 @@ def test_lu_solve_derivative_in_b_and_transpose():
     np.testing.assert_allclose(jac_rev, inverse, rtol=1e-11, atol=1e-13)
     # no derivative with respect to the factorised matrix (stop-gradient by design)
     assert float(jnp.max(jnp.abs(jax.grad(lambda s: lu_solve(lu_factor(a * s), b).sum())(1.0)))) == 0.0
-
-
-def test_diagonalised_shifted_solves_equal_numpy_and_stay_unbatched():
-    """``diagonalise(J).solve_shifted(s, r)`` = ``(I - s J)^-1 r`` for several shifts, single
-    and vmapped (the eigendecomposition a loop of unbatched LAPACK calls), with derivatives
-    in ``r`` (forward and reverse) equal to that inverse and none in ``J``."""
-    j, r = _general((3,)), jnp.asarray(RNG.normal(size=(3, N)))
-    for s in (0.0, 1e-3, 0.4):
-        expected = np.linalg.solve(np.eye(N) - s * np.asarray(j), np.asarray(r)[..., None])[..., 0]
-        got = jax.jit(jax.vmap(lambda a, b, s=s: diagonalise(a).solve_shifted(s, b)))(j, r)
-        np.testing.assert_allclose(got, expected, rtol=1e-11, atol=1e-13)
-    d = diagonalise(j[0])
-    assert float(d.error) < 1e-12
-    inverse = np.linalg.inv(np.eye(N) - 0.4 * np.asarray(j[0]))
-    np.testing.assert_allclose(jax.jacfwd(lambda b: d.solve_shifted(0.4, b))(r[0]), inverse, rtol=1e-11, atol=1e-13)
-    np.testing.assert_allclose(jax.jacrev(lambda b: d.solve_shifted(0.4, b))(r[0]), inverse, rtol=1e-11, atol=1e-13)
-    assert float(jnp.max(jnp.abs(jax.grad(lambda x: diagonalise(j[0] * x).solve_shifted(0.4, r[0]).sum())(1.0)))) == 0.0
-    hlo = jax.jit(jax.vmap(lambda a: diagonalise(a).eigenvalues)).lower(j).compile().as_text()
-    calls = re.findall(r"= \(?(f64\[[\d,]*\])[^\n]*custom-call\([^\n]*lapack", hlo)
-    assert calls and all(not shape.startswith("f64[3,") for shape in calls), calls

@@ -15,12 +15,10 @@ again at the start of each, one compiled segment solve in a ``lax.scan``: with K
 three segments took the step steer from 274 to about 210 steps, with KenCarp5 four take it
 in about 140 (docs/manoeuvre.md, "Speed").
 
-The implicit stage equations are then affine in the unknown, ``(I - s J0) x = r`` with
-one scalar ``s`` per step (both methods have one diagonal coefficient), so one Newton step
-solves them exactly: :class:`AffineRootFinder` diagonalises ``J0`` once per segment
-(:func:`jaxveh._linalg.diagonalise`) and solves each stage by two matrix products, where an
-LU factorisation per step (the previous way) cost a LAPACK call per step and per stage
-that a vmapped batch runs one member after the other. Optimistix's Newton would
+The implicit stage equations are then affine in the unknown, so one Newton step solves
+them exactly: :class:`AffineRootFinder` factorises their Jacobian once per step (Diffrax
+computes it at the second stage and reuses it for the others, both methods having one
+diagonal coefficient) and takes one step per stage, where Optimistix's Newton would
 re-linearise and iterate to a tolerance, and Diffrax's chord method (``VeryChord``) was
 seen to reject tens of thousands of steps at rtol 1e-4 on this car.
 
@@ -42,29 +40,29 @@ import optimistix as optx
 from jax.flatten_util import ravel_pytree
 
 from .._differences import forward_difference_jacobian
-from .._linalg import Diagonalised, diagonalise, lu_factor, lu_solve
+from .._linalg import lu_factor, lu_solve
 from ..multibody._simulate import _status
 
 
 class _AffineState(eqx.Module):
-    solve: object  # LU factors of the stage Jacobian, or the scale s of I - s J
+    lu: tuple
     steps: jax.Array
 
 
 class AffineRootFinder(optx.AbstractRootFinder):
-    """Root finder for an affine function ``fn(y) = A y + b``: one Newton step, which is
-    exact up to round-off. Only for affine functions: nothing checks the residual afterwards
-    (the implicit part of :func:`linearised_split` is affine by construction).
+    """Root finder for an affine function ``fn(y) = A y + b``: the LU factors of ``A`` and
+    one Newton step, which is exact up to round-off. Only for affine functions: nothing
+    checks the residual afterwards (the implicit part of :func:`linearised_split` is affine
+    by construction).
 
-    Given ``diagonal`` (:func:`jaxveh._linalg.diagonalise` of the ``J`` of an implicit term
-    ``J (y - y0)``), ``A = I - s J`` with the scalar ``s`` read from one directional
-    derivative (the stage equations of a diagonally implicit Runge-Kutta method on that
-    term have this form, ``s`` the diagonal coefficient times the step), and each stage is
-    solved by ``J``'s eigendecomposition: two matrix products, no factorisation per step
-    (docs/manoeuvre.md, "Solvers"). Without it, ``A`` comes from forward mode over every
-    state and is factorised (LU) once per step."""
+    ``A`` comes from forward mode over every state, or, given ``matrix`` (the ``J`` of an
+    implicit term ``J (y - y0)``), as ``I - s J`` with the scalar ``s`` read from one
+    directional derivative: the stage equations of a diagonally implicit Runge-Kutta method
+    on that term have this form (``s`` = the diagonal coefficient times the step), and
+    pushing every unit vector through ``J`` (a matrix product of the state's size cubed each
+    step) is then not needed."""
 
-    diagonal: Diagonalised | None = None
+    matrix: jax.Array | None = None
     rtol: float = 0.0  # unused: one step is exact (the fields Optimistix's root finders have)
     atol: float = 0.0
     norm: object = optx.max_norm
@@ -77,17 +75,17 @@ class AffineRootFinder(optx.AbstractRootFinder):
         def flat_fn(x):
             return ravel_pytree(fn(unravel(x), args)[0])[0]
 
-        if self.diagonal is None:
-            return _AffineState(lu_factor(jax.jacfwd(flat_fn)(flat)), jnp.asarray(0))
-        return _AffineState(_shift(self.diagonal.matrix, flat_fn, flat), jnp.asarray(0))
+        if self.matrix is None:
+            jacobian = jax.jacfwd(flat_fn)(flat)
+        else:
+            jacobian = _identity_minus_scaled(self.matrix, flat_fn, flat)
+        return _AffineState(lu_factor(jacobian), jnp.asarray(0))
 
     def step(self, fn, y, args, options, state, tags):
         del options, tags
         fx, aux = fn(y, args)
         flat, unravel = ravel_pytree(y)
-        r = ravel_pytree(fx)[0]
-        dx = lu_solve(state.solve, r) if self.diagonal is None else self.diagonal.solve_shifted(state.solve, r)
-        return unravel(flat - dx), _AffineState(state.solve, state.steps + 1), aux
+        return unravel(flat - lu_solve(state.lu, ravel_pytree(fx)[0])), _AffineState(state.lu, state.steps + 1), aux
 
     def terminate(self, fn, y, args, options, state, tags):
         del fn, y, args, options, tags
@@ -98,15 +96,16 @@ class AffineRootFinder(optx.AbstractRootFinder):
         return y, aux, {}
 
 
-def _shift(matrix, fn, x):
-    """The scalar ``s`` of an affine ``fn`` with Jacobian ``I - s J`` (``J`` = ``matrix``), by
-    least squares from one directional derivative along a fixed direction
-    with no zero entry (0 where ``J`` maps it to zero, so that ``s`` is immaterial)."""
+def _identity_minus_scaled(matrix, fn, x):
+    """The Jacobian ``I - s J`` of an affine ``fn`` at ``x`` (``J`` = ``matrix``), ``s`` by
+    least squares from one directional derivative along a fixed direction with no zero
+    entry (``I`` where ``J`` maps it to zero, so that ``s`` is immaterial)."""
     probe = jnp.cos(jnp.arange(1.0, x.shape[0] + 1.0))
     moved = jax.jvp(fn, (x,), (probe,))[1]
     image = matrix @ probe
     norm = jnp.dot(image, image)
-    return jnp.where(norm > 0.0, jnp.dot(image, probe - moved) / jnp.where(norm > 0.0, norm, 1.0), 0.0)
+    scale = jnp.where(norm > 0.0, jnp.dot(image, probe - moved) / jnp.where(norm > 0.0, norm, 1.0), 0.0)
+    return jnp.eye(x.shape[0], dtype=x.dtype) - scale * matrix
 
 
 def split_jacobian(field, y0, t0=0.0, explicit: tuple[int, ...] = ()) -> jax.Array:
@@ -155,28 +154,19 @@ IMEX_METHODS = {"kencarp5": diffrax.KenCarp5, "kencarp4": diffrax.KenCarp4}
 def imex_solver(matrix=None, method: str = "kencarp5") -> diffrax.AbstractSolver:
     """``KenCarp5`` (5th order, 8 stages; or ``"kencarp4"``: 4th order, 6 stages; both with an
     L-stable implicit part) with :class:`AffineRootFinder`, for the terms of
-    :func:`linearised_split` (``matrix``: their ``J0``, diagonalised once here, which spares
-    the root finder a forward-mode Jacobian and an LU factorisation each step)."""
+    :func:`linearised_split` (``matrix``: their ``J0``, which spares the root finder a
+    forward-mode Jacobian each step)."""
     if method not in IMEX_METHODS:
         raise ValueError(f"method = {method!r} is not an IMEX method: allowed {', '.join(map(repr, IMEX_METHODS))}")
-    diagonal = None if matrix is None else diagonalise(matrix)
-    return IMEX_METHODS[method](root_finder=AffineRootFinder(diagonal=diagonal))
+    return IMEX_METHODS[method](root_finder=AffineRootFinder(matrix=matrix))
 
 
-#: Largest relative error of the split matrix's eigendecomposition (``Diagonalised.error``)
-#: a segment accepts; beyond it (a matrix that is not diagonalisable) the segment's results
-#: are dropped (inf, as after a stop) and the solve fails, ``stats["split_not_diagonalisable"]``
-#: set.
-DIAGONAL_TOLERANCE = 1e-8
-
-
-def _with_diagonal(solver, diagonal: Diagonalised):
-    """``solver`` with its :class:`AffineRootFinder` told the split matrix's
-    eigendecomposition (other solvers as they are)."""
+def _with_matrix(solver, matrix):
+    """``solver`` with its :class:`AffineRootFinder` told the split's matrix (others as
+    they are)."""
     finder = getattr(solver, "root_finder", None)
-    if isinstance(finder, AffineRootFinder) and finder.diagonal is None:
-        return eqx.tree_at(lambda s: s.root_finder, solver, AffineRootFinder(diagonal=diagonal),
-                           is_leaf=lambda x: x is None)
+    if isinstance(finder, AffineRootFinder) and finder.matrix is None:
+        return eqx.tree_at(lambda s: s.root_finder, solver, AffineRootFinder(matrix=matrix))
     return solver
 
 
@@ -184,9 +174,7 @@ class SegmentedSolution(eqx.Module):
     """What :func:`relinearised_solve` returns: ``ys`` the states at the save times (inf
     after a stop, as Diffrax fills them), ``status`` (0 completed, 1 stopped by an event, 2
     solver failure), ``event_mask`` (which event condition stopped the run) and ``stats``
-    (steps, accepted and rejected steps summed over the segments; ``split_not_diagonalisable``:
-    a segment failed at its start because its split matrix's eigendecomposition was not
-    accurate to :data:`DIAGONAL_TOLERANCE`)."""
+    (steps, accepted and rejected steps summed over the segments)."""
 
     ys: object
     status: jax.Array
@@ -225,12 +213,9 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
         lambda c: lambda t, x, args, **kw: c(t, unravel(x), args, **kw), event.cond_fn, is_leaf=callable))
 
     def run(y, dt, a, b):
-        bad = jnp.asarray(False)
         if split:
             jacobian = split_jacobian(flat_field, y, a, explicit)
-            diagonal = diagonalise(jacobian)
-            bad = diagonal.error > DIAGONAL_TOLERANCE
-            terms, seg_solver = linearised_split(flat_field, y, a, jacobian), _with_diagonal(solver, diagonal)
+            terms, seg_solver = linearised_split(flat_field, y, a, jacobian), _with_matrix(solver, jacobian)
         else:
             terms, seg_solver = diffrax.ODETerm(flat_field), solver
         sol = diffrax.diffeqsolve(terms, seg_solver, a, b, dt, y, saveat=diffrax.SaveAt(ts=jnp.clip(ts, a, b), t1=True),
@@ -238,33 +223,30 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
                                   **options)
         counts = jnp.stack([jnp.asarray(sol.stats[k], jnp.int32) for k in _COUNTS])
         mask = jnp.stack([jnp.asarray(m, bool) for m in jax.tree.leaves(sol.event_mask)])
-        status = jnp.where(bad, 2, _status(sol.result)).astype(jnp.int32)
-        # a segment whose split could not be diagonalised failed at its start: nothing reached
-        ys, y_end = jnp.where(bad, jnp.inf, sol.ys[:-1]), jnp.where(bad, y, sol.ys[-1])
-        return ys, y_end, status, mask, counts, bad
+        status = _status(sol.result).astype(jnp.int32)
+        return sol.ys[:-1], sol.ys[-1], status, mask, counts
 
     def skip(y, dt, a, b):
         del dt, a, b
         return (jnp.full(ts.shape + y.shape, jnp.inf, y.dtype), y, jnp.asarray(0, jnp.int32),
-                jnp.zeros(n_conditions, bool), jnp.zeros(len(_COUNTS), jnp.int32), jnp.asarray(False))
+                jnp.zeros(n_conditions, bool), jnp.zeros(len(_COUNTS), jnp.int32))
 
     def segment(carry, ab):
         y, dt, status = carry
         a, b = ab
-        ys, y_end, seg_status, mask, counts, bad = jax.lax.cond(status != 0, skip, run, y, dt, a, b)
+        ys, y_end, seg_status, mask, counts = jax.lax.cond(status != 0, skip, run, y, dt, a, b)
         mean_step = jnp.minimum((b - a) / jnp.maximum(counts[1], 1).astype(b.dtype), b - a)
-        return (y_end, mean_step, jnp.maximum(status, seg_status)), (ys, mask, counts, bad)
+        return (y_end, mean_step, jnp.maximum(status, seg_status)), (ys, mask, counts)
 
     dt0 = jnp.asarray(dt0, ts.dtype)
     if segments == 1:  # the plain solve: no loop, no branch
-        ys, _, status, mask, count, bad = run(x0, dt0, edges[0], edges[1])
-        masks, counts, bads = mask[None], count[None], bad[None]
+        ys, _, status, mask, count = run(x0, dt0, edges[0], edges[1])
+        masks, counts = mask[None], count[None]
     else:
         start = (x0, dt0, jnp.asarray(0, jnp.int32))
-        (_, _, status), (ys, masks, counts, bads) = jax.lax.scan(segment, start, (edges[:-1], edges[1:]))
+        (_, _, status), (ys, masks, counts) = jax.lax.scan(segment, start, (edges[:-1], edges[1:]))
         # each save time from the segment it falls in (the last one holds t1)
         which = jnp.clip(jnp.searchsorted(edges, ts, side="right") - 1, 0, segments - 1)
         ys = ys[which, jnp.arange(ts.shape[0])]
-    stats = {k: counts[:, i].sum() for i, k in enumerate(_COUNTS)} | {
-        "max_steps": max_steps, "split_not_diagonalisable": bads.any()}
+    stats = {k: counts[:, i].sum() for i, k in enumerate(_COUNTS)} | {"max_steps": max_steps}
     return SegmentedSolution(ys=jax.vmap(unravel)(ys), status=status, event_mask=tuple(masks.any(axis=0)), stats=stats)

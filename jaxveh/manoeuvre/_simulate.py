@@ -39,7 +39,7 @@ from ..vehicle import (
 from ..vehicle._setup import CHASSIS_FORWARD, CHASSIS_LATERAL
 from ._channels import UNITS, car_channels
 from ._driver import AbstractSteeringLaw, Manoeuvre, kink_times
-from ._imex import DIAGONAL_TOLERANCE, IMEX_METHODS, imex_solver, relinearised_solve
+from ._imex import IMEX_METHODS, imex_solver, relinearised_solve
 from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
 from ._steady import compiled_core, condition_kinds, steady_state_core
 
@@ -375,9 +375,6 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
         reason = f"{EVENTS[int(stats['event']) - 1]} {after}"
     elif status == 2:
         reason = f"solver failure {after}"
-        if bool(stats.get("split_not_diagonalisable", False)):
-            reason += (" (the IMEX split's Jacobian could not be diagonalised to "
-                       f"{DIAGONAL_TOLERANCE:g}; solver='tsit5' does without it)")
         if throw:
             raise RuntimeError(f"the {form} car's integration failed: {reason}")
     return CarRun(ts=ts, channels=channels, steps=stats["num_steps"], rejected_steps=stats["num_rejected_steps"],
