@@ -60,6 +60,14 @@ def run_time_checks_off():
         errors.EQX_ON_ERROR = before
 
 
+def run_time_checks_on() -> bool:
+    """False inside :func:`run_time_checks_off`: a traced check would be compiled out, so
+    jaxveh's checks skip building it (less to trace and compile)."""
+    import equinox._errors as errors
+
+    return getattr(errors, "EQX_ON_ERROR", "raise") != "off"
+
+
 def as_float(x):
     """Convert to a float64 array (keeps tracers; a new value never retraces)."""
     return jnp.asarray(x, dtype=jnp.float64)
@@ -84,6 +92,8 @@ def check_range(name: str, value, *, low=None, high=None, low_open=False, high_o
     ``value`` as float64.
     """
     value = as_float(value)
+    if not is_concrete(value) and not run_time_checks_on():
+        return value
     lo_txt = "-inf" if low is None else f"{low:g}"
     hi_txt = "inf" if high is None else f"{high:g}"
     allowed = f"{'(' if low_open or low is None else '['}{lo_txt}, {hi_txt}{')' if high_open or high is None else ']'}"

@@ -1,16 +1,25 @@
-"""XLA CPU options jaxveh can set when it is imported, opt-in (docs/manoeuvre.md, "Speed").
+"""XLA CPU options jaxveh sets when it is imported (docs/manoeuvre.md, "Speed").
 
-XLA's newer CPU fusion emitters compile the car's vector field into code that runs about a
-third slower, and compiles about a third slower, than the classic loop emitters on these
-machines (the fast car's step steer: one evaluation 94 -> 71 us, compilation 46 -> 34 s,
-the same results to round-off). With ``JAXVEH_XLA_FLAGS=1`` :func:`apply_cpu_flags` adds
-``--xla_cpu_use_fusion_emitters=false`` to ``XLA_FLAGS`` before JAX starts its CPU backend.
-It is off by default: with it, a vmapped batch of 16 step steers hung twice in jaxlib's
-LAPACK thread pool (docs/manoeuvre.md, "Speed"), which without it happened only in sweeps.
+XLA's newer CPU fusion emitters compile the car into code that runs slower, and compile it
+slower, than the classic loop emitters on these machines. Measured 2026-12-05 in fresh
+processes on the fast car's step steer (6 modes): the step-steer program compiles in 23
+s instead of 46 s and its steady-state program in 15 s instead of 24 s, one run takes 0.14
+s instead of 0.18-0.20 s, and a vmapped batch of 64 on 2 cores gives 30 instead of 27
+simulations/s, with the same results to round-off. :func:`apply_cpu_flags` therefore adds
+``--xla_cpu_use_fusion_emitters=false`` to ``XLA_FLAGS`` before JAX starts its CPU backend;
+``JAXVEH_XLA_FLAGS=0`` leaves ``XLA_FLAGS`` alone.
+
+It was opt-in until then: in its first benchmark a vmapped batch of 16 step steers hung
+twice in jaxlib 0.10's LAPACK thread pool, two batched LAPACK calls each waiting for the
+other's threads. That hang is jaxlib's, not the emitters' (sweeps met it without them), and
+the batched LAPACK call it was met in, the IMEX root finder's LU, has since run one system
+after the other (:mod:`jaxveh._linalg`); batches of 1, 16 and 64 then ran to the end with
+the flag, in one call and spread over the cores.
 
 XLA aborts the process on a flag it does not know, so the flag is added only for the jaxlib
 versions it was measured on (:data:`TESTED_JAXLIB`) and never when ``XLA_FLAGS`` already
-names it. It has no effect when a JAX computation ran before jaxveh was imported (the backend reads ``XLA_FLAGS`` once).
+names it. It has no effect when a JAX computation ran before jaxveh was imported (the
+backend reads ``XLA_FLAGS`` once).
 """
 
 import os
@@ -29,8 +38,13 @@ def _jaxlib_version() -> tuple[int, ...]:
 
 def apply_cpu_flags(environ=os.environ, jaxlib_version: tuple[int, ...] | None = None) -> tuple[str, ...]:
     """Add :data:`CPU_FLAGS` to ``environ["XLA_FLAGS"]`` where allowed (module docs); return
-    the flags added."""
-    if environ.get("JAXVEH_XLA_FLAGS", "0") != "1":
+    the flags added. ``JAXVEH_XLA_FLAGS``: "1" (the default, also when unset or empty) or "0"
+    (add nothing); any other value raises ``ValueError``."""
+    setting = environ.get("JAXVEH_XLA_FLAGS", "") or "1"
+    if setting not in ("0", "1"):
+        raise ValueError(f"JAXVEH_XLA_FLAGS = {setting!r} is not allowed: '1' (the default: jaxveh sets its XLA "
+                         "CPU flags) or '0' (leave XLA_FLAGS alone)")
+    if setting == "0":
         return ()
     version = _jaxlib_version() if jaxlib_version is None else tuple(jaxlib_version)
     if version[:2] not in TESTED_JAXLIB:

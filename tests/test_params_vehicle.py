@@ -218,3 +218,33 @@ def test_file_checks_derived_values():
 def test_appendix_b_modules_check_on_construction(build, match):
     with pytest.raises(ParameterError, match=match):
         build(load_vehicle_data())
+
+
+class _Spring(eqx.Module):
+    rate: jax.Array
+
+
+def _checked_spring(rate):
+    from jaxveh.params._checks import Range, check_module
+
+    return check_module(_Spring(rate), "Spring", {"rate": Range(low=0.0, what="N/m")}).rate
+
+
+def test_traced_checks_run_and_are_not_built_when_run_time_checks_are_off():
+    """A traced value out of range fails at run time; inside ``run_time_checks_off`` the
+    check is not traced at all (nothing to compile), and a concrete value is still refused."""
+    from jaxveh import run_time_checks_off
+    from jaxveh._core import check_range
+
+    with pytest.raises(Exception, match=r"Spring\.rate must lie in \[0, inf\)"):
+        jax.block_until_ready(jax.jit(_checked_spring)(jnp.asarray(-1.0)))
+    with pytest.raises(Exception, match=r"k must lie in \[0, inf\)"):
+        jax.block_until_ready(jax.jit(lambda x: check_range("k", x, low=0.0))(jnp.asarray(-1.0)))
+    with run_time_checks_off():
+        # new functions: JAX's trace cache would return the traces made with checks on
+        for fn in (lambda x: _checked_spring(x), lambda x: check_range("k", x, low=0.0)):
+            jaxpr = jax.make_jaxpr(fn)(jnp.asarray(-1.0, jnp.float64))
+            assert not jaxpr.eqns, jaxpr  # the value passes straight through
+            assert float(jax.jit(fn)(jnp.asarray(-1.0))) == -1.0
+        with pytest.raises(ParameterError, match=r"Spring\.rate must lie in \[0, inf\)"):
+            _checked_spring(np.asarray(-1.0))

@@ -21,7 +21,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._core import ParameterError, as_float, check_range, is_concrete
+from .._core import ParameterError, as_float, check_range, is_concrete, run_time_checks_on
 from ._schema import UNIT_TO_SI, Quantity
 
 
@@ -126,6 +126,8 @@ def require(x, bad, message: str):
         if np.any(np.asarray(bad)):
             raise ParameterError(message)
         return x
+    if not run_time_checks_on():
+        return x
     return eqx.error_if(x, jnp.any(bad), message)
 
 
@@ -168,12 +170,16 @@ def check_module(module, prefix: str, ranges: Mapping[str, Range], relations: Se
         for name, fn, rng in relations:  # only once every field is valid
             _raise_if_bad(f"{prefix}: {name}", fn(module), rng)
         return original
+    checks_on = run_time_checks_on()  # off: a traced check would be compiled out, so none is built
     names, preds = [], []
     items = [(f"{prefix}.{key}", getattr(module, key), rng) for key, rng in ranges.items()]
-    items += [(f"{prefix}: {name}", fn(module), rng) for name, fn, rng in relations]
+    if checks_on:
+        items += [(f"{prefix}: {name}", fn(module), rng) for name, fn, rng in relations]
     for name, value, rng in items:
         if is_concrete(value):
             check(name, value, rng)
+            continue
+        if not checks_on:
             continue
         pred = jnp.any(rng.bad(value))
         if is_concrete(pred):  # eager jax.grad: the values are known

@@ -57,17 +57,19 @@ def _axle(axle: str) -> str:
 
 def installation_ratios(axle: str = "front", data=None, bump=0.0) -> InstallationRatios:
     """Installation ratios of the left corner of ``axle`` at wheel-centre travel ``bump``
-    (m, positive up relative to the chassis), zero rack. Compiled once per axle."""
+    (m, positive up relative to the chassis), zero rack. One compilation serves both axles
+    (their quarter cars have one structure; the axle's hard points and wheel centre are
+    data)."""
     data = load_vehicle_data() if data is None else data
     # the structure from the shipped data, the (possibly traced) hard points as leaves
     system, params = quarter_car(None, _axle(axle))
-    return _installation_ratios(system, params, axle, data, jnp.asarray(bump, jnp.float64))
+    hp = (data.hard_points_front if axle == "front" else data.hard_points_rear).points
+    return _installation_ratios(system, params, hp, quarter_car_wheel_centre(data, axle),
+                                jnp.asarray(bump, jnp.float64))
 
 
 @eqx.filter_jit
-def _installation_ratios(system, params, axle: str, data, bump) -> InstallationRatios:
-    hp = (data.hard_points_front if axle == "front" else data.hard_points_rear).points
-    wheel_centre = quarter_car_wheel_centre(data, axle)
+def _installation_ratios(system, params, hp, wheel_centre, bump) -> InstallationRatios:
     params = quarter_car_with_hard_points(system, params, hp, wheel_centre)
     xa, xb, xc, xd, xp, xq, xr, xs, xt = (hp[HARD_POINT_NAMES.index(n)] for n in "ABCDPQRST")
     wishbone = wishbone_geometry(xa, xb, xc, xd)
