@@ -1,13 +1,15 @@
 """XLA CPU options jaxveh sets when it is imported (docs/manoeuvre.md, "Speed").
 
-XLA's newer CPU fusion emitters compile the car into code that runs slower, and compile it
-slower, than the classic loop emitters on these machines. Measured 2026-12-05 in fresh
-processes on the fast car's step steer (6 modes): the step-steer program compiles in 23
-s instead of 46 s and its steady-state program in 15 s instead of 24 s, one run takes 0.14
-s instead of 0.18-0.20 s, and a vmapped batch of 64 on 2 cores gives 30 instead of 27
-simulations/s, with the same results to round-off. :func:`apply_cpu_flags` therefore adds
+XLA's newer CPU fusion emitters take about twice as long as the classic loop emitters to
+compile the car's programs on these machines. Measured 2026-12-05 in fresh
+processes on the fast car's 6-mode step steer: the step-steer program compiles in 23 s
+instead of 46 s and its steady-state program in 15 s instead of 24 s; one run takes
+0.12-0.14 s instead of 0.16 s; vmapped batches lose about a tenth (a batch of 64 on 2 cores
+30-33 against 37 simulations/s, where the newer emitters vectorise across the batch
+better); the results agree to round-off. Compilation being what users of the car wait for
+most (docs/manoeuvre.md, "Compilation"), :func:`apply_cpu_flags` adds
 ``--xla_cpu_use_fusion_emitters=false`` to ``XLA_FLAGS`` before JAX starts its CPU backend;
-``JAXVEH_XLA_FLAGS=0`` leaves ``XLA_FLAGS`` alone.
+``JAXVEH_XLA_FLAGS=0`` leaves ``XLA_FLAGS`` alone (large vmapped batches may prefer that).
 
 It was opt-in until then: in its first benchmark a vmapped batch of 16 step steers hung
 twice in jaxlib 0.10's LAPACK thread pool, two batched LAPACK calls each waiting for the
