@@ -88,8 +88,8 @@ def check_range(name: str, value, *, low=None, high=None, low_open=False, high_o
 
     Concrete values raise :class:`ParameterError` naming ``name``, the offending value and
     the allowed range; traced values are checked at run time with ``eqx.error_if`` (the
-    returned array must then be used). NaN and infinities are always refused. Returns
-    ``value`` as float64.
+    returned array must then be used), except inside :func:`run_time_checks_off`. NaN and
+    infinities are always refused. Returns ``value`` as float64.
     """
     value = as_float(value)
     if not is_concrete(value) and not run_time_checks_on():

@@ -158,7 +158,8 @@ def check_module(module, prefix: str, ranges: Mapping[str, Range], relations: Se
 
     Concrete violations raise :class:`ParameterError` naming ``prefix.field``; traced values
     are checked at run time with one ``eqx.branched_error_if`` on the module's leaves, whose
-    message names the first violated field. The returned module must be used. Relation
+    message names the first violated field (inside :func:`jaxveh._core.run_time_checks_off`
+    traced values are not checked: the caller checked them before tracing). The returned module must be used. Relation
     functions receive NumPy leaves when the whole module is concrete (use ``array_module``).
     """
     original = module
