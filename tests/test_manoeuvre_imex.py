@@ -317,3 +317,18 @@ def test_solver_names():
     with pytest.raises(jaxveh.ParameterError, match="solver = 'rk4' is not available: allowed 'auto', 'tsit5', "
                                                    "'kencarp5', 'kencarp4', 'kvaerno5'"):
         pick_solver("rk4", "fast", 1e-4)
+
+
+def test_manoeuvre_channels_takes_auto():
+    """``manoeuvre_channels(solver="auto")`` picks as :func:`pick_solver` does (it was refused
+    with a message listing "auto" as allowed); with a traced rtol it cannot pick and says so.
+    Traced only (``jax.eval_shape``): the channels of the rigid car's step steer."""
+    from jaxveh.manoeuvre import manoeuvre_channels, save_times, step_steer
+    from jaxveh.vehicle import load_car
+
+    car, m = load_car(modes=0), step_steer(duration=1.0)
+    ts = save_times(m, 11)
+    channels, _, _ = jax.eval_shape(lambda: manoeuvre_channels(car, m, ts, form="fast", solver="auto", rtol=1e-4))
+    assert channels["yaw_rate"].shape == (11,)
+    with pytest.raises(jaxveh.ParameterError, match="solver = 'auto' picks by rtol, which is traced here"):
+        jax.eval_shape(lambda r: manoeuvre_channels(car, m, ts, form="fast", solver="auto", rtol=r), 1e-4)

@@ -112,6 +112,7 @@ def linear_field(car, trim, speed, channels):
     model = fast_model(car)
     x0, unravel = jax.flatten_util.ravel_pytree(trim.state)
 
+    @jax.jit  # one trace serves the value and both Jacobians
     def field(x, w):
         w = jnp.reshape(w, (3, 5))
         road = _PolynomialRoad(w[:, :4])

@@ -21,7 +21,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .. import multibody as mb
-from .._core import ParameterError, run_time_checks_off
+from .._core import ParameterError, is_concrete, run_time_checks_off
 from ..multibody._simulate import _hold_after_stop
 from ..vehicle import (
     ConstantSpeed,
@@ -160,12 +160,16 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps,
     s0 = FastState(trim.state.q, trim.state.u, jnp.concatenate([trim.state.aux, driving.aux0]))
     model = fast_model(car)
 
+    # jitted so that one trace serves the stage loop, the split's Jacobian and the channels
+    # (JAX's trace cache): the car's equations were traced seven times, half the tracing time
+    dynamics = jax.jit(lambda t, s: fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements))
+
     def field(t, s, args):
-        d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
+        d = dynamics(t, s)
         return FastState(d.q_dot, d.u_dot, d.aux_dot)
 
     def channels(t, s):
-        d = fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements)
+        d = dynamics(t, s)
         out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], driving.angle(t, s.aux))
         return out | {"constraint_residual": d.link_residual}
 
@@ -241,8 +245,11 @@ def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, s
     (library form): hold the projection matrices for that many steps
     (:class:`jaxveh.multibody.ProjectedSolver`; 0: exact). ``linearisations`` (fast form,
     IMEX solvers): time segments of the run, each with the IMEX split linearised at its start
-    (:data:`LINEARISATIONS`; 1: once, at the start); ``max_steps`` holds per segment."""
+    (:data:`LINEARISATIONS`; 1: once, at the start); ``max_steps`` holds per segment.
+    ``solver``: one of :data:`SOLVERS`, or "auto" (:func:`pick_solver`, which needs a
+    concrete ``rtol``)."""
     run = _fast if check_form(form) == "fast" else _library
+    solver = _resolved_solver(solver, form, rtol)
     _check_freeze_steps(freeze_steps, form)
     _check_linearisations(linearisations)
     if adjoint is not None and form != "fast":
@@ -250,6 +257,15 @@ def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, s
                              "with Diffrax's default adjoint)")
     trim = straight_trim(car, manoeuvre.speed, form) if trim is None else trim
     return run(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint, linearisations)
+
+
+def _resolved_solver(solver: str, form: str, rtol) -> str:
+    if solver != "auto":
+        return solver
+    if not is_concrete(rtol):
+        raise ParameterError("solver = 'auto' picks by rtol, which is traced here: pass a concrete rtol or name one "
+                             f"of {', '.join(map(repr, SOLVERS))}")
+    return pick_solver(solver, form, float(rtol))
 
 
 def _check_linearisations(linearisations) -> None:
