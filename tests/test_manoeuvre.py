@@ -12,7 +12,7 @@ import xarray
 from typer.testing import CliRunner
 
 from jaxveh import analysis
-from jaxveh._core import GRAVITY, ParameterError
+from jaxveh._core import GRAVITY, ParameterError, run_time_checks_off
 from jaxveh.cli import app
 from jaxveh.manoeuvre import (
     PATH_CHANNELS,
@@ -22,6 +22,7 @@ from jaxveh.manoeuvre import (
     RampSteer,
     StepSteer,
     Straight,
+    StraightTrim,
     SweptSine,
     four_post,
     kink_times,
@@ -33,6 +34,7 @@ from jaxveh.manoeuvre import (
     step_steer_metrics,
     write_netcdf,
 )
+from jaxveh.manoeuvre._simulate import _compiled_trim
 from jaxveh.tyre import mirror_symmetric
 from jaxveh.vehicle import load_car
 from optimise import _response as response
@@ -353,6 +355,22 @@ def test_a_spinning_car_stops_with_the_event_named(runs, form, rtol):
     assert 0 < valid.sum() < valid.size and not valid[-1]
     assert all(np.all(np.isfinite(np.asarray(v))) for v in run.channels.values())
     assert abs(float(np.asarray(run.channels["sideslip"])[valid][-1])) > 30.0
+
+
+@pytest.mark.slow
+def test_start_trim_is_the_steady_state_without_its_channels(runs):
+    """The start of every fast run (:class:`StraightTrim`, a program without the channels)
+    is :func:`steady_state` at zero yaw rate: the same state, rack and speed target to
+    1e-12; a speed that cannot be solved for is not ``ok``."""
+    car, speed = load_car(modes=6), 25.0
+    trim, ss = start_trim(car, speed), steady_state(car, speed=speed, yaw_rate=0.0)
+    assert isinstance(trim, StraightTrim) and bool(trim.ok)
+    for a, b in zip(jax.tree.leaves((trim.state, trim.rack, trim.speed_target)),
+                    jax.tree.leaves((ss.state, ss.rack, ss.speed_target))):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    with run_time_checks_off():
+        _, ok = _compiled_trim(car, jnp.asarray(jnp.nan), "fast")
+    assert not bool(ok)
 
 
 @pytest.mark.slow

@@ -107,8 +107,8 @@ def linear_field(car, trim, speed, channels):
     """``(field, x0)``: ``field(x, w) -> (x_dot, y)``, the fast car's vector field and the
     ``channels`` at the flat state ``x`` and inputs ``w`` (15: the 5 inputs of
     :data:`INPUTS`, then their first and second derivatives), about the straight-running
-    ``trim`` (a :class:`jaxveh.manoeuvre.SteadyCornering`) at ``speed`` (m/s); ``x0`` the
-    trim's flat state."""
+    ``trim`` (a :class:`jaxveh.manoeuvre.StraightTrim`, or a steady state with a ``state``
+    and a ``rack``) at ``speed`` (m/s); ``x0`` the trim's flat state."""
     model = fast_model(car)
     x0, unravel = jax.flatten_util.ravel_pytree(trim.state)
 

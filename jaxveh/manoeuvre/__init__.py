@@ -63,6 +63,7 @@ from ._steady import (
     CONDITIONS as CONDITIONS,
     SkidPad as SkidPad,
     SteadyCornering as SteadyCornering,
+    StraightTrim as StraightTrim,
     skid_pad as skid_pad,
     skid_pad_core as skid_pad_core,
     steady_state as steady_state,

@@ -41,7 +41,7 @@ from ._channels import UNITS, car_channels
 from ._driver import AbstractSteeringLaw, Manoeuvre, kink_times
 from ._imex import IMEX_METHODS, imex_solver, relinearised_solve
 from ._pursuit import DRIVER_STATES, DriverElement, PurePursuit, driver_inputs
-from ._steady import compiled_core, condition_kinds, steady_state_core
+from ._steady import straight_trim_core
 
 #: Solvers by name (docs/manoeuvre.md compares them): explicit Tsit5; the IMEX KenCarp5 and
 #: KenCarp4 (the fast car: its linearisation implicit, taken again in each of
@@ -283,25 +283,26 @@ def _check_freeze_steps(freeze_steps, form: str) -> None:
 
 def straight_trim(car, speed, form: str):
     """Straight running at ``speed`` (m/s) in ``form``: the fast car's own steady state
-    (:func:`jaxveh.manoeuvre.steady_state` with zero yaw rate) or the library car's
+    (:class:`jaxveh.manoeuvre.StraightTrim`: :func:`jaxveh.manoeuvre.steady_state` with zero
+    yaw rate, without its channels) or the library car's
     :func:`jaxveh.vehicle.straight_running`; both have a ``rack``."""
     if check_form(form) == "fast":
-        return steady_state_core(car, condition_kinds(("speed", "yaw_rate")), (speed, 0.0))[0]
+        return straight_trim_core(car, speed)
     return straight_running(car, speed)
 
 
 # the trim and the run compile separately (one large program compiles far slower than two)
 _compiled_library_trim = eqx.filter_jit(straight_running)
+_compiled_fast_trim = eqx.filter_jit(straight_trim_core)
 _compiled = eqx.filter_jit(manoeuvre_channels)
 
 
 def _compiled_trim(car, speed, form):
-    """``(trim, ok)``: :func:`straight_trim` compiled (the fast car's is the steady-state
-    program every :func:`jaxveh.manoeuvre.steady_state` call uses) and whether its Newton
-    solve converged."""
+    """``(trim, ok)``: :func:`straight_trim` compiled and whether its Newton solve
+    converged."""
     speed = jnp.asarray(speed, jnp.float64)
     if form == "fast":
-        trim = compiled_core(car, condition_kinds(("speed", "yaw_rate")), jnp.stack([speed, jnp.zeros_like(speed)]))[0]
+        trim = _compiled_fast_trim(car, speed)
         return trim, trim.ok
     trim = _compiled_library_trim(car, speed)
     return trim, trim.static.ok
