@@ -358,7 +358,7 @@ def test_a_spinning_car_stops_with_the_event_named(runs, form, rtol):
 
 
 @pytest.mark.slow
-def test_start_trim_is_the_steady_state_without_its_channels(runs):
+def test_start_trim_is_the_steady_state_without_its_channels():
     """The start of every fast run (:class:`StraightTrim`, a program without the channels)
     is :func:`steady_state` at zero yaw rate: the same state, rack and speed target to
     1e-12; a speed that cannot be solved for is not ``ok``."""
