@@ -190,14 +190,17 @@ def _result(car, model, kinds, values, x, converged) -> SteadyCornering:
                        residual=residual, ok=ok)
 
 
+#: Newton steps allowed to the straight-running trim (as :func:`steady_state`'s default).
+TRIM_MAX_STEPS = 64
+
+
 class StraightTrim(eqx.Module):
     """Straight running of the fast car, where a manoeuvre starts: its ``state`` (heading,
     position and spin angles 0), the ``rack`` travel (m), the powertrain's ``speed_target``
     (m/s) and ``ok`` (Newton converged to a finite state). The same state as
-    :func:`steady_state` at zero yaw rate, without the channels and the residual there: a
-    program that needs only the start holds the car's equations once (Newton's loop), where
-    the channels and the residual at the root were a second copy (7.8 -> 4.1 s of XLA
-    compilation, docs/manoeuvre.md "Compilation")."""
+    :func:`steady_state` at zero yaw rate, without the channels and the residual there, so
+    that its program holds the car's equations once, in Newton's loop (docs/manoeuvre.md,
+    "Compilation")."""
 
     state: FastState
     rack: Float[Array, ""]
@@ -212,7 +215,7 @@ def straight_trim_core(car, speed) -> StraightTrim:
     n_aux = _n_aux(car)
     speed = jnp.asarray(speed, jnp.float64)
     kinds, values = condition_kinds(("speed", "yaw_rate")), jnp.stack([speed, jnp.zeros_like(speed)])
-    x, converged = _solve(car, model, kinds, values, initial_guess(car, kinds, values), 64)
+    x, converged = _solve(car, model, kinds, values, initial_guess(car, kinds, values), TRIM_MAX_STEPS)
     q, u, rack, aux, speed_target, _ = _unpack(car, x, n_aux)
     return StraightTrim(state=FastState(q, u, aux), rack=rack, speed_target=speed_target,
                         ok=converged & jnp.all(jnp.isfinite(x)))
