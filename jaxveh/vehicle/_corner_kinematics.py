@@ -141,14 +141,16 @@ def link_residual(w, geometry: CornerGeometry, travel, rack, pivots):
 def link_jacobians(w, geometry: CornerGeometry, travel, rack, pivots):
     """``(residual, d residual / dw (5, 5), d/d travel (5,), d/d rack (5,), d/d pivots
     (5, 3))`` of :func:`link_residual`, in closed form (``d residual / d d = d / l``)."""
-    d, slopes = _links(w, geometry, travel, rack, pivots, derivatives=True)
+    rotations = jnp.stack([jnp.stack([jnp.stack(row) for row in a]) for a in _rotation_zxy([w[2], w[3], w[4]], True)])
+    turned = jnp.einsum("aij,lj->ali", rotations, geometry.outer)  # (4, 5, 3): A p and its derivatives
+    r = jnp.stack([geometry.centre[0] + w[0], geometry.centre[1] + w[1], geometry.centre[2] + travel])
+    shift = jnp.stack([jnp.zeros_like(geometry.rack), rack * geometry.rack, jnp.zeros_like(geometry.rack)], axis=1)
+    d = pivots + shift - r[None, :] - turned[0]
     inv = 1.0 / geometry.lengths
-    residual = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - geometry.lengths**2) * (0.5 * inv)
-    unit = [di * inv for di in d]
-    turned = [_turn(a, geometry.outer) for a in slopes]
-    jac_w = jnp.stack([-unit[0], -unit[1]] + [-(unit[0] * t[0] + unit[1] * t[1] + unit[2] * t[2]) for t in turned],
-                      axis=1)
-    return residual, jac_w, -unit[2], geometry.rack * unit[1], jnp.stack(unit, axis=1)
+    residual = (jnp.sum(d * d, axis=1) - geometry.lengths**2) * (0.5 * inv)
+    unit = d * inv[:, None]
+    jac_w = jnp.concatenate([-unit[:, :2], -jnp.einsum("li,ali->la", unit, turned[1:])], axis=1)
+    return residual, jac_w, -unit[:, 2], geometry.rack * unit[:, 1], unit
 
 
 #: Pivot rows of the elimination, fixed: the order partial pivoting picks for the library
@@ -335,7 +337,7 @@ def corner_motion(geometry: CornerGeometry, kmap: KinematicMap, travel, rack, mo
             return link_residual(w, g, t, s, piv)
 
         _, jac_w, jac_t, jac_s, jac_piv = link_jacobians(w, g, t, rack, piv)
-        jac_p = sum(jac_piv[:, i, None] * g.inner_shapes[:, i, :] for i in range(3))
+        jac_p = jnp.einsum("li,lim->lm", jac_piv, g.inner_shapes)
         sens = -solve_small(jac_w, jnp.concatenate([jac_t[:, None], jac_s[:, None], jac_p], axis=1))
         w_dot = sens @ jnp.concatenate([jnp.stack([t_rate, rack_rate]), modal_rate])
 
