@@ -120,27 +120,28 @@ def _turn(a: list, p) -> list:
     return [a[i][0] * p[:, 0] + a[i][1] * p[:, 1] + a[i][2] * p[:, 2] for i in range(3)]
 
 
-def _links(w, geometry: CornerGeometry, travel, rack, pivots, derivatives: bool = False):
+def _links(w, geometry: CornerGeometry, travel, rack, pivots):
     """Components ``(d_x, d_y, d_z)`` (5,) each of inner pivot minus outer point (m, chassis
-    axes), and with ``derivatives`` the rotation's derivatives (see :func:`_rotation_zxy`)."""
-    rotations = _rotation_zxy([w[2], w[3], w[4]], derivatives)
-    outer = _turn(rotations[0], geometry.outer)
+    axes)."""
+    outer = _turn(_rotation_zxy([w[2], w[3], w[4]])[0], geometry.outer)
     r = [geometry.centre[0] + w[0], geometry.centre[1] + w[1], geometry.centre[2] + travel]
     shift = [0.0, rack * geometry.rack, 0.0]
-    d = [pivots[:, i] + shift[i] - r[i] - outer[i] for i in range(3)]
-    return d, rotations[1:]
+    return [pivots[:, i] + shift[i] - r[i] - outer[i] for i in range(3)]
 
 
 def link_residual(w, geometry: CornerGeometry, travel, rack, pivots):
     """The five link equations of one corner, ``(|d|^2 - l^2) / (2 l)`` (m). ``pivots``:
     the inner pivots (5, 3) with the chassis deformation, before the rack."""
-    (dx, dy, dz), _ = _links(w, geometry, travel, rack, pivots)
+    dx, dy, dz = _links(w, geometry, travel, rack, pivots)
     return (dx * dx + dy * dy + dz * dz - geometry.lengths**2) / (2.0 * geometry.lengths)
 
 
 def link_jacobians(w, geometry: CornerGeometry, travel, rack, pivots):
     """``(residual, d residual / dw (5, 5), d/d travel (5,), d/d rack (5,), d/d pivots
-    (5, 3))`` of :func:`link_residual`, in closed form (``d residual / d d = d / l``)."""
+    (5, 3))`` of :func:`link_residual`, in closed form (``d residual / d d = d / l``). The
+    rotation and its three derivatives turn the upright points in one product: written
+    elementwise, XLA fused the rotation's sines and cosines into every entry of the
+    Jacobians and recomputed them there (docs/manoeuvre.md, "Speed")."""
     rotations = jnp.stack([jnp.stack([jnp.stack(row) for row in a]) for a in _rotation_zxy([w[2], w[3], w[4]], True)])
     turned = jnp.einsum("aij,lj->ali", rotations, geometry.outer)  # (4, 5, 3): A p and its derivatives
     r = jnp.stack([geometry.centre[0] + w[0], geometry.centre[1] + w[1], geometry.centre[2] + travel])
