@@ -23,7 +23,7 @@ from jaxveh.vehicle import (
     system_params,
     travel_from_library,
 )
-from jaxveh.vehicle._corner_kinematics import MAP_RACK, MAP_TRAVEL, _newton
+from jaxveh.vehicle._corner_kinematics import MAP_RACK, MAP_TRAVEL, _newton, link_curvature, link_residual
 
 N_STATES = 100
 
@@ -140,6 +140,35 @@ def test_kinematic_map_guess_and_exact_solve(car):
     assert float(jnp.max(solve_error)) < 1e-11  # two Newton iterations reach the exact pose
     assert float(jnp.max(residual)) < 1e-11
 
+
+def test_link_curvature_equals_the_second_derivative_by_autodiff(car):
+    """The closed-form velocity-product term of the link equations equals the second
+    derivative of the residual along the motion by nested forward mode, at random poses,
+    rates, pivots and pivot rates of every corner (a fourth of them at design pose)."""
+    g = jax.jit(fast_model)(car).geometry
+    rng = np.random.default_rng(11)
+    n = 8
+    w = jnp.asarray(rng.normal(size=(n, 4, 5)) * [0.01, 0.01, 0.05, 0.05, 0.05])
+    w_dot = jnp.asarray(rng.normal(size=(n, 4, 5)) * [0.2, 0.2, 1.0, 1.0, 3.0])
+    w = w.at[: n // 4].set(0.0)
+    travel, travel_rate = jnp.asarray(rng.uniform(*MAP_TRAVEL, (n, 4))), jnp.asarray(rng.normal(size=(n, 4)))
+    rack, rack_rate = jnp.asarray(rng.uniform(*MAP_RACK, n)), jnp.asarray(rng.normal(size=n) * 0.1)
+    pivots = g.inner[None] + jnp.asarray(rng.normal(size=(n, *g.inner.shape)) * 1e-3)
+    pivot_rates = jnp.asarray(rng.normal(size=(n, *g.inner.shape)) * 1e-2)
+
+    def by_autodiff(w, wd, gg, t, td, r, rd, piv, pivd):
+        def along(e):
+            return link_residual(w + e * wd, gg, t + e * td, r + e * rd, piv + e * pivd)
+
+        zero = jnp.zeros(())
+        return jax.jvp(lambda e: jax.jvp(along, (e,), (jnp.ones(()),))[1], (zero,), (jnp.ones(()),))[1]
+
+    corners = jax.vmap(jax.vmap(by_autodiff, (0, 0, 0, 0, 0, None, None, 0, 0)), (0, 0, None, 0, 0, 0, 0, 0, 0))
+    closed = jax.vmap(jax.vmap(link_curvature, (0, 0, 0, 0, 0, None, None, 0, 0)), (0, 0, None, 0, 0, 0, 0, 0, 0))
+    args = (w, w_dot, g, travel, travel_rate, rack, rack_rate, pivots, pivot_rates)
+    expected, got = jax.jit(corners)(*args), jax.jit(closed)(*args)
+    assert float(jnp.max(jnp.abs(expected))) > 1e-2  # the rotation's and the pivots' terms both act
+    np.testing.assert_allclose(got, expected, rtol=1e-11, atol=1e-13 * float(jnp.max(jnp.abs(expected))))
 
 def test_gradients_of_an_acceleration_match_central_differences(car):
     """Spring rate (front left), a hard point (front lower wishbone pivot A, z) and a modal

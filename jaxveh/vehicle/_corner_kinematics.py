@@ -154,6 +154,66 @@ def link_jacobians(w, geometry: CornerGeometry, travel, rack, pivots):
     return residual, jac_w, -unit[:, 2], geometry.rack * unit[:, 1], unit
 
 
+
+#: The two axes each elementary rotation turns, in its own order (x: y -> z, y: z -> x, z: x -> y).
+_PLANE = {0: (1, 2), 1: (2, 0), 2: (0, 1)}
+
+
+def _rotate_jet(axis: int, angle, rate, jet):
+    """The jet (value, first and second derivative along the motion; each three component
+    arrays) of ``R v`` for the rotation ``R`` about ``axis`` by ``angle`` turning at ``rate``
+    (rad per unit of the motion), from the jet of ``v`` (``None`` for a zero derivative).
+    ``R' u`` turns the rotated vector a quarter turn in the plane of the rotation and
+    ``R'' u`` is minus its part in that plane."""
+    i, j = _PLANE[axis]
+    c, s = jnp.cos(angle), jnp.sin(angle)
+
+    def turn(v):
+        out = list(v)
+        out[i], out[j] = c * v[i] - s * v[j], s * v[i] + c * v[j]
+        return out
+
+    def quarter(u):
+        out = [0.0, 0.0, 0.0]
+        out[i], out[j] = -u[j], u[i]
+        return out
+
+    value, first, second = jet
+    rv = turn(value)
+    rv_q = quarter(rv)
+    d1 = [rate * a for a in rv_q]
+    d2 = [0.0, 0.0, 0.0]
+    d2[i], d2[j] = -rate * rate * rv[i], -rate * rate * rv[j]
+    if first is not None:
+        r1 = turn(first)
+        d1 = [a + b for a, b in zip(d1, r1, strict=True)]
+        d2 = [a + 2.0 * rate * b for a, b in zip(d2, quarter(r1), strict=True)]
+    if second is not None:
+        d2 = [a + b for a, b in zip(d2, turn(second), strict=True)]
+    return rv, d1, d2
+
+
+def link_curvature(w, w_dot, geometry: CornerGeometry, travel, travel_rate, rack, rack_rate, pivots, pivot_rates):
+    """Second derivative (m per unit of the motion squared) of :func:`link_residual` of one
+    corner along the straight motion ``w + e w_dot``, ``travel + e travel_rate``,
+    ``rack + e rack_rate``, ``pivots + e pivot_rates`` at ``e = 0``, in closed form: with
+    ``d`` the links' vectors, ``(d' . d' + d . d'') / l``, where only the upright's rotation
+    makes ``d''`` non-zero. (Computed before as a nested forward-mode derivative, which cost a
+    third of the car's evaluation: docs/manoeuvre.md, "Speed".)"""
+    jet = ([geometry.outer[:, k] for k in range(3)], None, None)
+    for axis, k in ((1, 4), (0, 3), (2, 2)):  # "zxy": the y rotation acts first
+        jet = _rotate_jet(axis, w[k], w_dot[k], jet)
+    turned, turned_rate, turned_acc = jet
+    r = [geometry.centre[0] + w[0], geometry.centre[1] + w[1], geometry.centre[2] + travel]
+    r_rate = [w_dot[0], w_dot[1], travel_rate]
+    shift, shift_rate = [0.0, rack * geometry.rack, 0.0], [0.0, rack_rate * geometry.rack, 0.0]
+    total = 0.0
+    for k in range(3):
+        d = pivots[:, k] + shift[k] - r[k] - turned[k]
+        d_rate = pivot_rates[:, k] + shift_rate[k] - r_rate[k] - turned_rate[k]
+        total = total + d_rate * d_rate - d * turned_acc[k]
+    return total / geometry.lengths
+
 #: Pivot rows of the elimination, fixed: the order partial pivoting picks for the library
 #: car's link Jacobian over the map's range (the alternative it picks at some states swaps
 #: the last two rows; the fixed order's pivots stay above 0.8 of partial pivoting's,
@@ -328,25 +388,18 @@ def corner_motion(geometry: CornerGeometry, kmap: KinematicMap, travel, rack, mo
     """Poses, rates and velocity-product accelerations of the four uprights at travels
     (4,) and rates, rack travel, rate and acceleration (scalars, m), modal coordinates and
     rates. Rates by the implicit function theorem on the link equations, the
-    velocity-product terms by their second directional derivative along the motion."""
+    velocity-product terms by their second directional derivative along the motion
+    (:func:`link_curvature`)."""
     w = corner_poses(geometry, kmap, travel, rack, modes)
     pivots = geometry.inner + jnp.einsum("kpim,m->kpi", geometry.inner_shapes, modes)
     pivot_rates = jnp.einsum("kpim,m->kpi", geometry.inner_shapes, modal_rate)
 
     def one(g, w, t, piv, t_rate, piv_rate):
-        def res(w, t, s, piv):
-            return link_residual(w, g, t, s, piv)
-
         _, jac_w, jac_t, jac_s, jac_piv = link_jacobians(w, g, t, rack, piv)
         jac_p = jnp.einsum("li,lim->lm", jac_piv, g.inner_shapes)
         sens = -solve_small(jac_w, jnp.concatenate([jac_t[:, None], jac_s[:, None], jac_p], axis=1))
         w_dot = sens @ jnp.concatenate([jnp.stack([t_rate, rack_rate]), modal_rate])
-
-        def along(e):
-            return res(w + e * w_dot, t + e * t_rate, rack + e * rack_rate, piv + e * piv_rate)
-
-        zero = jnp.zeros_like(t)
-        curvature = jax.jvp(lambda e: jax.jvp(along, (e,), (jnp.ones_like(e),))[1], (zero,), (jnp.ones_like(zero),))[1]
+        curvature = link_curvature(w, w_dot, g, t, t_rate, rack, rack_rate, piv, piv_rate)
         w_acc0 = sens[:, 1] * rack_acc - solve_small(jac_w, curvature)
         return sens, w_dot, w_acc0
 
