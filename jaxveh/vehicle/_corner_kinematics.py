@@ -120,10 +120,12 @@ def _turn(a: list, p) -> list:
     return [a[i][0] * p[:, 0] + a[i][1] * p[:, 1] + a[i][2] * p[:, 2] for i in range(3)]
 
 
-def _links(w, geometry: CornerGeometry, travel, rack, pivots):
+def _links(w, geometry: CornerGeometry, travel, rack, pivots, outer=None):
     """Components ``(d_x, d_y, d_z)`` (5,) each of inner pivot minus outer point (m, chassis
-    axes)."""
-    outer = _turn(_rotation_zxy([w[2], w[3], w[4]])[0], geometry.outer)
+    axes); ``outer``: the upright points already turned by the pose's rotation (components),
+    where the caller has them."""
+    if outer is None:
+        outer = _turn(_rotation_zxy([w[2], w[3], w[4]])[0], geometry.outer)
     r = [geometry.centre[0] + w[0], geometry.centre[1] + w[1], geometry.centre[2] + travel]
     shift = [0.0, rack * geometry.rack, 0.0]
     return [pivots[:, i] + shift[i] - r[i] - outer[i] for i in range(3)]
@@ -203,14 +205,12 @@ def link_curvature(w, w_dot, geometry: CornerGeometry, travel, travel_rate, rack
     for axis, k in ((1, 4), (0, 3), (2, 2)):  # "zxy": the y rotation acts first
         jet = _rotate_jet(axis, w[k], w_dot[k], jet)
     turned, turned_rate, turned_acc = jet
-    r = [geometry.centre[0] + w[0], geometry.centre[1] + w[1], geometry.centre[2] + travel]
-    r_rate = [w_dot[0], w_dot[1], travel_rate]
-    shift, shift_rate = [0.0, rack * geometry.rack, 0.0], [0.0, rack_rate * geometry.rack, 0.0]
+    d = _links(w, geometry, travel, rack, pivots, outer=turned)
+    centre_rate, shift_rate = [w_dot[0], w_dot[1], travel_rate], [0.0, rack_rate * geometry.rack, 0.0]
     total = 0.0
     for k in range(3):
-        d = pivots[:, k] + shift[k] - r[k] - turned[k]
-        d_rate = pivot_rates[:, k] + shift_rate[k] - r_rate[k] - turned_rate[k]
-        total = total + d_rate * d_rate - d * turned_acc[k]
+        d_rate = pivot_rates[:, k] + shift_rate[k] - centre_rate[k] - turned_rate[k]
+        total = total + d_rate * d_rate - d[k] * turned_acc[k]
     return total / geometry.lengths
 
 
