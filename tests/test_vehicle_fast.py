@@ -170,6 +170,7 @@ def test_link_curvature_equals_the_second_derivative_by_autodiff(car):
     assert float(jnp.max(jnp.abs(expected))) > 1e-2  # the rotation's and the pivots' terms both act
     np.testing.assert_allclose(got, expected, rtol=1e-11, atol=1e-13 * float(jnp.max(jnp.abs(expected))))
 
+
 def test_gradients_of_an_acceleration_match_central_differences(car):
     """Spring rate (front left), a hard point (front lower wishbone pivot A, z) and a modal
     stiffness multiplier, through the parameter pytree, the map and the corner solve."""

@@ -181,8 +181,7 @@ def _rotate_jet(axis: int, angle, rate, jet):
 
     value, first, second = jet
     rv = turn(value)
-    rv_q = quarter(rv)
-    d1 = [rate * a for a in rv_q]
+    d1 = [rate * a for a in quarter(rv)]
     d2 = [0.0, 0.0, 0.0]
     d2[i], d2[j] = -rate * rate * rv[i], -rate * rate * rv[j]
     if first is not None:
