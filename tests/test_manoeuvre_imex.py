@@ -1,6 +1,6 @@
-"""The fast car's IMEX pieces (jaxveh.manoeuvre._imex) on small systems: the affine root
-finder against NumPy's solve, the linearised split adding up to the vector field, and
-KenCarp4 with both on a stiff oscillator coupled to a slow pendulum against SciPy's
+"""The fast car's IMEX pieces (jaxveh.manoeuvre._imex) on small systems: the linear-implicit
+solver against Diffrax's KenCarp with Newton, the linearised split adding up to the vector
+field, and KenCarp4 with both on a stiff oscillator coupled to a slow pendulum against SciPy's
 implicit Radau at tight tolerance, and derivatives through the solve (reverse and forward
 mode) against a central difference; the same in time segments linearised again at each
 segment's start (``relinearised_solve``), and a stop by an event in a segment. The car's
@@ -17,8 +17,7 @@ import scipy.integrate
 
 import jaxveh  # noqa: F401  (float64)
 from jaxveh.manoeuvre._imex import (
-    AffineRootFinder,
-    _identity_minus_scaled,
+    LinearImplicitARK,
     imex_solver,
     linearised_split,
     relinearised_solve,
@@ -26,45 +25,48 @@ from jaxveh.manoeuvre._imex import (
 )
 
 
-def test_affine_root_finder_solves_in_one_step():
-    rng = np.random.default_rng(0)
-    a = rng.normal(size=(5, 5)) + 5.0 * np.eye(5)
-    b = rng.normal(size=5)
-    fn = lambda y, args: {"x": a[:3] @ jnp.concatenate([y["x"], y["z"]]) - b[:3],  # noqa: E731
-                          "z": a[3:] @ jnp.concatenate([y["x"], y["z"]]) - b[3:]}
-    sol = optx.root_find(fn, AffineRootFinder(), {"x": jnp.ones(3), "z": jnp.zeros(2)})
-    np.testing.assert_allclose(np.concatenate([sol.value["x"], sol.value["z"]]), np.linalg.solve(a, b), rtol=1e-12)
-    assert int(sol.stats["num_steps"]) == 1
-
-
 def _stiff_field(t, y, args, np=jnp):
     """A 500 rad/s oscillator (1 % damping) coupled to a slow nonlinear pendulum."""
     x, v, p, w = y
     return np.stack([v, -500.0**2 * (x - 0.01 * np.sin(p)) - 2 * 0.01 * 500.0 * v, w, -10.0 * np.sin(p) + x])
 
-def test_stage_jacobian_from_the_split_matrix():
-    """The root finder told the split's matrix J builds the stage Jacobian as I - s J, s from
-    one directional derivative: equal to forward mode on a stage equation of Diffrax's form
-    (f - J (y_p + s f - y0)); the identity where J maps the probe to zero; and KenCarp4 with it
-    takes the same steps to the same solution as with forward-mode Jacobians."""
+@pytest.mark.parametrize("method, cls", [("kencarp5", diffrax.KenCarp5), ("kencarp4", diffrax.KenCarp4)])
+def test_linear_implicit_ark_steps_as_diffrax_kencarp(method, cls):
+    """The linear-implicit solver, told the split's matrix or taking it by forward mode, takes
+    the same steps to the same solution as Diffrax's KenCarp with Optimistix's Newton solving
+    each stage to round-off, and its derivative (the stage arithmetic differentiated) equals
+    Diffrax's (the implicit-function rule at each stage)."""
     y0 = jnp.asarray([0.0, 0.0, 1.0, 0.0])
     jac = split_jacobian(_stiff_field, y0)
-    y_p, s = jnp.asarray([1e-3, 0.2, 0.7, -0.4]), 0.37 * 2e-3
-
-    def stage(f):
-        return f - jac @ (y_p + s * f - y0)
-
-    f = jnp.asarray([0.3, -2.0, 0.1, 5.0])
-    exact = jax.jacfwd(stage)(f)
-    np.testing.assert_allclose(_identity_minus_scaled(jac, stage, f), exact, rtol=1e-13, atol=1e-15)
-    assert np.array_equal(np.asarray(_identity_minus_scaled(jnp.zeros((4, 4)), lambda x: 2.0 * x, f)), np.eye(4))
     ts = jnp.linspace(0.0, 2.0, 21)
-    runs = [diffrax.diffeqsolve(linearised_split(_stiff_field, y0, jacobian=jac), solver, 0.0, 2.0, 1e-3, y0,
-                                saveat=diffrax.SaveAt(ts=ts), max_steps=100_000,
-                                stepsize_controller=diffrax.PIDController(rtol=1e-6, atol=1e-8))
-            for solver in (imex_solver(), imex_solver(matrix=jac))]
-    assert int(runs[0].stats["num_steps"]) == int(runs[1].stats["num_steps"])
-    np.testing.assert_allclose(runs[1].ys, runs[0].ys, rtol=1e-10, atol=1e-12)
+
+    def run(solver, scale=1.0):
+        field = lambda t, y, args: scale * _stiff_field(t, y, args)  # noqa: E731
+        return diffrax.diffeqsolve(linearised_split(field, y0, jacobian=jac), solver, 0.0, 2.0, 1e-3, y0,
+                                   saveat=diffrax.SaveAt(ts=ts), max_steps=100_000,
+                                   stepsize_controller=diffrax.PIDController(rtol=1e-6, atol=1e-8))
+
+    reference = cls(root_finder=optx.Newton(rtol=1e-13, atol=1e-14))
+    runs = [run(solver) for solver in (reference, imex_solver(matrix=jac, method=method), imex_solver(method=method))]
+    for sol in runs[1:]:
+        assert int(sol.stats["num_steps"]) == int(runs[0].stats["num_steps"])
+        np.testing.assert_allclose(sol.ys, runs[0].ys, rtol=1e-9, atol=1e-11)
+    linear = imex_solver(matrix=jac, method=method)
+    derivatives = [jax.grad(lambda x, s=solver: run(s, x).ys[-1, 2])(1.0) for solver in (reference, linear)]
+    np.testing.assert_allclose(derivatives[1], derivatives[0], rtol=1e-8)
+
+
+def test_linear_implicit_ark_refuses_bad_input():
+    """A state that is not flat, a matrix of the wrong shape and an unknown method are refused
+    by name."""
+    y0 = jnp.zeros(4)
+    terms = linearised_split(_stiff_field, y0)
+    with pytest.raises(ValueError, match=r"flat state \(n,\): got shape \(2, 2\)"):
+        imex_solver().init(terms, 0.0, 1.0, jnp.zeros((2, 2)), None)
+    with pytest.raises(ValueError, match=r"matrix has shape \(3, 3\): .* is \(4, 4\)"):
+        imex_solver(matrix=jnp.eye(3)).init(terms, 0.0, 1.0, y0, None)
+    with pytest.raises(ValueError, match="method = 'kvaerno5' is not an IMEX method: allowed 'kencarp5', 'kencarp4'"):
+        LinearImplicitARK(method="kvaerno5")
 
 
 def test_relinearised_solve_keeps_the_state_pytree():
@@ -155,7 +157,8 @@ def test_imex_matches_radau(method):
 
 def test_imex_solver_names_its_methods():
     """KenCarp5 by default; an unknown method is refused by name."""
-    assert isinstance(imex_solver(), diffrax.KenCarp5) and isinstance(imex_solver(method="kencarp4"), diffrax.KenCarp4)
+    assert imex_solver().method == "kencarp5" and imex_solver(method="kencarp4").method == "kencarp4"
+    assert imex_solver().order(None) == 5 and imex_solver(method="kencarp4").order(None) == 4
     with pytest.raises(ValueError, match="method = 'kvaerno5' is not an IMEX method: allowed 'kencarp5', 'kencarp4'"):
         imex_solver(method="kvaerno5")
 
@@ -284,8 +287,8 @@ def test_derivatives_through_the_relinearised_solve():
 
 
 def test_derivatives_through_the_imex_solve():
-    """Reverse mode (Diffrax's checkpointing) and forward mode through the split, the solver
-    and the affine root finder equal a central difference."""
+    """Reverse mode (Diffrax's checkpointing) and forward mode through the split and the
+    linear-implicit solver equal a central difference."""
     g, h = 10.0, 1e-4
     plain = diffrax.RecursiveCheckpointAdjoint()
     fd = (_pendulum_end(g + h, plain) - _pendulum_end(g - h, plain)) / (2 * h)
@@ -298,10 +301,9 @@ def test_derivatives_through_the_imex_solve():
 def test_solver_names():
     """``pick_solver``: "auto" takes KenCarp5 on the fast car from AUTO_IMEX_RTOL up and Tsit5
     below it and on the library car; each name builds its solver (the fast car's IMEX with
-    the affine root finder, the library car's with Optimistix's Newton); an unknown name is
+    the linear-implicit solver, the library car's Diffrax KenCarp with Optimistix's Newton); an unknown name is
     refused with the allowed ones."""
     from jaxveh.manoeuvre import AUTO_IMEX_RTOL, IMEX_SOLVERS, SOLVERS, pick_solver
-    from jaxveh.manoeuvre._imex import AffineRootFinder
     from jaxveh.manoeuvre._simulate import _solver
 
     assert pick_solver("auto", "fast", 1e-4) == "kencarp5" and pick_solver("auto", "fast", AUTO_IMEX_RTOL) == "kencarp5"
@@ -312,7 +314,7 @@ def test_solver_names():
         assert pick_solver(name, "library", 1e-4) == name
     for name, cls in (("kencarp5", diffrax.KenCarp5), ("kencarp4", diffrax.KenCarp4)):
         fast, library = _solver(name, "fast"), _solver(name, "library")
-        assert type(fast) is cls and isinstance(fast.root_finder, AffineRootFinder)
+        assert type(fast) is LinearImplicitARK and fast.method == name
         assert type(library) is cls and isinstance(library.root_finder, optx.Newton)
     with pytest.raises(jaxveh.ParameterError, match="solver = 'rk4' is not available: allowed 'auto', 'tsit5', "
                                                    "'kencarp5', 'kencarp4', 'kvaerno5'"):

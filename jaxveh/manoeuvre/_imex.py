@@ -15,12 +15,14 @@ again at the start of each, one compiled segment solve in a ``lax.scan``: with K
 three segments took the step steer from 274 to about 210 steps, with KenCarp5 four take it
 in about 140 (docs/manoeuvre.md, "Speed").
 
-The implicit stage equations are then affine in the unknown, so one Newton step solves
-them exactly: :class:`AffineRootFinder` factorises their Jacobian once per step (Diffrax
-computes it at the second stage and reuses it for the others, both methods having one
-diagonal coefficient) and takes one step per stage, where Optimistix's Newton would
-re-linearise and iterate to a tolerance, and Diffrax's chord method (``VeryChord``) was
-seen to reject tens of thousands of steps at rtol 1e-4 on this car.
+The implicit stage equations are then linear in the unknown: :class:`LinearImplicitARK`
+(Diffrax's KenCarp tableaux and dense output) factorises ``I - h gamma J0`` once per step
+(both methods have one diagonal coefficient) and solves each stage with it, with no root
+finder. Optimistix's Newton would re-linearise and iterate to a tolerance, Diffrax's chord
+method (``VeryChord``) was seen to reject tens of thousands of steps at rtol 1e-4 on this
+car, and even a one-step root finder left Diffrax's implicit stages their root-finding
+machinery (a Jacobian cond per stage and, in reverse mode, a Jacobian materialised and
+factorised per stage by the implicit-function rule): the step cost about 20 % more.
 
 Some states are left out of the implicit part (``explicit``: their columns of ``J0`` are
 zero, so the field's dependence on them stays whole in the explicit part): the car's
@@ -32,80 +34,126 @@ travelled, is cancelled by the explicit part, and held the closed-loop skid-pad'
 near 9 ms where 35 ms hold its accuracy (docs/manoeuvre.md, "Speed").
 """
 
+from typing import ClassVar
+
 import diffrax
 import equinox as eqx
 import jax
 import jax.numpy as jnp
-import optimistix as optx
+import numpy as np
 from jax.flatten_util import ravel_pytree
 
 from .._differences import forward_difference_jacobian
 from .._linalg import lu_factor, lu_solve
 from ..multibody._simulate import _status
 
+#: The additive Runge-Kutta methods of :class:`LinearImplicitARK`, by name: Diffrax's solver
+#: whose tableaux and dense output it takes, and its order.
+IMEX_METHODS = {"kencarp5": (diffrax.KenCarp5, 5), "kencarp4": (diffrax.KenCarp4, 4)}
 
-class _AffineState(eqx.Module):
-    lu: tuple
-    steps: jax.Array
+
+def _tableau_matrices(method: str):
+    """The additive Runge-Kutta method ``method``'s coefficients from Diffrax's tableaux
+    (NumPy): stage-coupling matrices ``a`` (explicit, implicit: stages x stages, the
+    implicit one without its diagonal), the implicit diagonal ``gamma`` (stages,), the
+    stage times ``c``, the weights ``b`` and error weights ``b_error`` of each part."""
+    explicit, implicit = IMEX_METHODS[method][0].tableau.tableaus
+    stages = implicit.num_stages
+
+    def lower(tableau):
+        a = np.zeros((stages, stages))
+        for i, row in enumerate(tableau.a_lower, start=1):
+            a[i, :i] = row
+        return a
+
+    c = np.concatenate([[explicit.c1], explicit.c])
+    return ((lower(explicit), lower(implicit)), np.asarray(implicit.a_diagonal), c,
+            (explicit.b_sol, implicit.b_sol), (explicit.b_error, implicit.b_error))
 
 
-class AffineRootFinder(optx.AbstractRootFinder):
-    """Root finder for an affine function ``fn(y) = A y + b``: the LU factors of ``A`` and
-    one Newton step, which is exact up to round-off. Only for affine functions: nothing
-    checks the residual afterwards (the implicit part of :func:`linearised_split` is affine
-    by construction).
+class LinearImplicitARK(diffrax.AbstractAdaptiveSolver):
+    """Kennedy and Carpenter's additive Runge-Kutta method ``method`` ("kencarp5": 5th order,
+    8 stages; "kencarp4": 4th order, 6 stages; Diffrax's tableaux and dense output) for
+    terms ``MultiTerm(explicit, implicit)`` whose implicit part is linear with the
+    constant matrix ``matrix`` (n x n): ``implicit(t, y) = matrix (y - y0) + const``, as
+    :func:`linearised_split` builds (without ``matrix`` the solver takes the term's Jacobian
+    at the start, by forward mode). The state is a flat array (n,).
 
-    ``A`` comes from forward mode over every state, or, given ``matrix`` (the ``J`` of an
-    implicit term ``J (y - y0)``), as ``I - s J`` with the scalar ``s`` read from one
-    directional derivative: the stage equations of a diagonally implicit Runge-Kutta method
-    on that term have this form (``s`` = the diagonal coefficient times the step), and
-    pushing every unit vector through ``J`` (a matrix product of the state's size cubed each
-    step) is then not needed."""
+    Each implicit stage equation ``y_i = z_i + h gamma implicit(y_i)`` is then linear,
+    ``(I - h gamma matrix) (y_i - z_i) = h gamma implicit(z_i)``, and the step solves it
+    with one LU factorisation per step (every stage has the same diagonal coefficient),
+    with no root finder and no implicit-function rule in reverse mode: the derivatives are
+    those of the stage arithmetic. Diffrax's ``KenCarp5`` with a root finder takes the
+    same steps to the same solution (tests/test_manoeuvre_imex.py); the root finder's
+    reverse pass (a Jacobian materialised and factorised per stage) cost about as much as
+    the vector field's (docs/manoeuvre.md, "Speed")."""
 
     matrix: jax.Array | None = None
-    rtol: float = 0.0  # unused: one step is exact (the fields Optimistix's root finders have)
-    atol: float = 0.0
-    norm: object = optx.max_norm
+    method: str = eqx.field(static=True, default="kencarp5")
 
-    def init(self, fn, y, args, options, f_struct, aux_struct, tags):
-        if "init_state" in options:  # Diffrax's Jacobian of an earlier stage of the step
-            return options["init_state"]
-        flat, unravel = ravel_pytree(y)
+    term_structure: ClassVar = diffrax.MultiTerm[tuple[diffrax.AbstractTerm, diffrax.AbstractTerm]]
 
-        def flat_fn(x):
-            return ravel_pytree(fn(unravel(x), args)[0])[0]
+    def __check_init__(self):
+        if self.method not in IMEX_METHODS:
+            raise ValueError(f"method = {self.method!r} is not an IMEX method: allowed "
+                             f"{', '.join(map(repr, IMEX_METHODS))}")
 
-        if self.matrix is None:
-            jacobian = jax.jacfwd(flat_fn)(flat)
-        else:
-            jacobian = _identity_minus_scaled(self.matrix, flat_fn, flat)
-        return _AffineState(lu_factor(jacobian), jnp.asarray(0))
+    @property
+    def interpolation_cls(self):
+        return IMEX_METHODS[self.method][0].interpolation_cls
 
-    def step(self, fn, y, args, options, state, tags):
-        del options, tags
-        fx, aux = fn(y, args)
-        flat, unravel = ravel_pytree(y)
-        return unravel(flat - lu_solve(state.lu, ravel_pytree(fx)[0])), _AffineState(state.lu, state.steps + 1), aux
+    def order(self, terms):
+        del terms
+        return IMEX_METHODS[self.method][1]
 
-    def terminate(self, fn, y, args, options, state, tags):
-        del fn, y, args, options, tags
-        return state.steps >= 1, optx.RESULTS.successful
+    def init(self, terms, t0, t1, y0, args):
+        """The solver state: ``None`` with ``matrix`` given, else the implicit term's
+        Jacobian at the start by forward mode (constant: the term is linear)."""
+        del t1
+        if jnp.ndim(y0) != 1:
+            raise ValueError(f"LinearImplicitARK steps a flat state (n,): got shape {jnp.shape(y0)}")
+        if self.matrix is not None:
+            if self.matrix.shape != (y0.shape[0],) * 2:
+                raise ValueError(f"matrix has shape {self.matrix.shape}: the implicit term's Jacobian over the "
+                                 f"state of shape {y0.shape} is ({y0.shape[0]}, {y0.shape[0]})")
+            return None
+        return jax.lax.stop_gradient(jax.jacfwd(lambda y: terms.terms[1].vf(t0, y, args))(y0))
 
-    def postprocess(self, fn, y, aux, args, options, state, tags, result):
-        del fn, args, options, state, tags, result
-        return y, aux, {}
+    def step(self, terms, t0, t1, y0, args, solver_state, made_jump):
+        del made_jump
+        matrix = self.matrix if self.matrix is not None else solver_state
+        explicit, implicit = terms.terms
+        (a_explicit, a_implicit), gamma, c, (b_explicit, b_implicit), (e_explicit, e_implicit) = (
+            _tableau_matrices(self.method))
+        h = t1 - t0
+        stages, n = gamma.shape[0], y0.shape[0]
+        factors = lu_factor(jnp.eye(n, dtype=y0.dtype) - (h * gamma[-1]) * matrix)
 
+        def stage(ks, coefficients):
+            k_explicit, k_implicit = ks
+            i, row_explicit, row_implicit, diagonal, ci = coefficients
+            z = y0 + row_explicit @ k_explicit + row_implicit @ k_implicit
+            t = t0 + ci * h
+            # diagonal is 0 at the explicit first stage: the solve then returns 0
+            y = z + lu_solve(factors, (h * diagonal) * implicit.vf(t, z, args))
+            k_explicit = k_explicit.at[i].set(h * explicit.vf(t, y, args))
+            k_implicit = k_implicit.at[i].set(h * implicit.vf(t, y, args))
+            return (k_explicit, k_implicit), None
 
-def _identity_minus_scaled(matrix, fn, x):
-    """The Jacobian ``I - s J`` of an affine ``fn`` at ``x`` (``J`` = ``matrix``), ``s`` by
-    least squares from one directional derivative along a fixed direction with no zero
-    entry (``I`` where ``J`` maps it to zero, so that ``s`` is immaterial)."""
-    probe = jnp.cos(jnp.arange(1.0, x.shape[0] + 1.0))
-    moved = jax.jvp(fn, (x,), (probe,))[1]
-    image = matrix @ probe
-    norm = jnp.dot(image, image)
-    scale = jnp.where(norm > 0.0, jnp.dot(image, probe - moved) / jnp.where(norm > 0.0, norm, 1.0), 0.0)
-    return jnp.eye(x.shape[0], dtype=x.dtype) - scale * matrix
+        zeros = jnp.zeros((stages, n), y0.dtype)
+        coefficients = (jnp.arange(stages), jnp.asarray(a_explicit, y0.dtype), jnp.asarray(a_implicit, y0.dtype),
+                        jnp.asarray(gamma, y0.dtype), jnp.asarray(c, y0.dtype))
+        (k_explicit, k_implicit), _ = jax.lax.scan(stage, (zeros, zeros), coefficients)
+        y1 = y0 + jnp.asarray(b_explicit, y0.dtype) @ k_explicit + jnp.asarray(b_implicit, y0.dtype) @ k_implicit
+        error = jnp.asarray(e_explicit, y0.dtype) @ k_explicit + jnp.asarray(e_implicit, y0.dtype) @ k_implicit
+        # a non-finite step is rejected by the step-size controller, not saved
+        error = jnp.where(jnp.all(jnp.isfinite(y1)), error, jnp.inf)
+        dense_info = dict(y0=y0, y1=y1, k=(k_explicit, k_implicit))
+        return y1, error, dense_info, solver_state, diffrax.RESULTS.successful
+
+    def func(self, terms, t0, y0, args):
+        explicit, implicit = terms.terms
+        return explicit.vf(t0, y0, args) + implicit.vf(t0, y0, args)
 
 
 def split_jacobian(field, y0, t0=0.0, explicit: tuple[int, ...] = ()) -> jax.Array:
@@ -147,26 +195,18 @@ def linearised_split(field, y0, t0=0.0, jacobian=None, explicit: tuple[int, ...]
     return diffrax.MultiTerm(diffrax.ODETerm(explicit_part), diffrax.ODETerm(implicit_part))
 
 
-#: The additive Runge-Kutta methods :func:`imex_solver` builds, by name.
-IMEX_METHODS = {"kencarp5": diffrax.KenCarp5, "kencarp4": diffrax.KenCarp4}
-
-
-def imex_solver(matrix=None, method: str = "kencarp5") -> diffrax.AbstractSolver:
+def imex_solver(matrix=None, method: str = "kencarp5") -> LinearImplicitARK:
     """``KenCarp5`` (5th order, 8 stages; or ``"kencarp4"``: 4th order, 6 stages; both with an
-    L-stable implicit part) with :class:`AffineRootFinder`, for the terms of
-    :func:`linearised_split` (``matrix``: their ``J0``, which spares the root finder a
-    forward-mode Jacobian each step)."""
-    if method not in IMEX_METHODS:
-        raise ValueError(f"method = {method!r} is not an IMEX method: allowed {', '.join(map(repr, IMEX_METHODS))}")
-    return IMEX_METHODS[method](root_finder=AffineRootFinder(matrix=matrix))
+    L-stable implicit part) for the terms of :func:`linearised_split` (``matrix``: their
+    ``J0``; :func:`relinearised_solve` sets it for each segment)."""
+    return LinearImplicitARK(matrix=matrix, method=method)
 
 
 def _with_matrix(solver, matrix):
-    """``solver`` with its :class:`AffineRootFinder` told the split's matrix (others as
-    they are)."""
-    finder = getattr(solver, "root_finder", None)
-    if isinstance(finder, AffineRootFinder) and finder.matrix is None:
-        return eqx.tree_at(lambda s: s.root_finder, solver, AffineRootFinder(matrix=matrix))
+    """``solver`` told the split's matrix when it is a :class:`LinearImplicitARK` without one
+    (others as they are)."""
+    if isinstance(solver, LinearImplicitARK) and solver.matrix is None:
+        return eqx.tree_at(lambda s: s.matrix, solver, matrix, is_leaf=lambda x: x is None)
     return solver
 
 

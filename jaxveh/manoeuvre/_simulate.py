@@ -107,7 +107,8 @@ def _solver(name: str, form: str = "library"):
 
         # Newton, not Diffrax's default chord iteration (far more steps on this problem)
         newton = optx.Newton(rtol=1e-8, atol=1e-10)
-        return (IMEX_METHODS | {"kvaerno5": diffrax.Kvaerno5})[name](root_finder=newton)
+        library_solvers = {name: cls for name, (cls, _) in IMEX_METHODS.items()} | {"kvaerno5": diffrax.Kvaerno5}
+        return library_solvers[name](root_finder=newton)
     raise ParameterError(f"solver = {name!r} is not available: allowed 'auto', {', '.join(map(repr, SOLVERS))}")
 
 
