@@ -1,4 +1,4 @@
-"""An LU solve that stays unbatched under ``jax.vmap`` (the IMEX root finder's).
+"""An LU solve that stays unbatched under ``jax.vmap`` (the IMEX solver's stage solves).
 
 jaxlib 0.10.2 splits a batched LAPACK call (a vmapped Cholesky, LU or triangular solve)
 over its CPU thread pool and waits for the parts; two such calls running at once can each

@@ -14,7 +14,7 @@ most (docs/manoeuvre.md, "Compilation"), :func:`apply_cpu_flags` adds
 It was opt-in until then: in its first benchmark a vmapped batch of 16 step steers hung
 twice in jaxlib 0.10's LAPACK thread pool, two batched LAPACK calls each waiting for the
 other's threads. That hang is jaxlib's, not the emitters' (sweeps met it without them), and
-the batched LAPACK call it was met in, the IMEX root finder's LU, has since run one system
+the batched LAPACK call it was met in, the IMEX stage solves' LU, has since run one system
 after the other (:mod:`jaxveh._linalg`); batches of 1, 16 and 64 then ran to the end with
 the flag, in one call and spread over the cores.
 

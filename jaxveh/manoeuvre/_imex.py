@@ -84,9 +84,9 @@ class LinearImplicitARK(diffrax.AbstractAdaptiveSolver):
     with one LU factorisation per step (every stage has the same diagonal coefficient),
     with no root finder and no implicit-function rule in reverse mode: the derivatives are
     those of the stage arithmetic. Diffrax's ``KenCarp5`` with a root finder takes the
-    same steps to the same solution (tests/test_manoeuvre_imex.py); the root finder's
-    reverse pass (a Jacobian materialised and factorised per stage) cost about as much as
-    the vector field's (docs/manoeuvre.md, "Speed")."""
+    same steps to the same solution with the same derivatives
+    (tests/test_manoeuvre_imex.py); on the car this step's forward pass costs about 20 %
+    less (docs/manoeuvre.md, "Speed", nineteenth measurement)."""
 
     matrix: jax.Array | None = None
     method: str = eqx.field(static=True, default="kencarp5")
