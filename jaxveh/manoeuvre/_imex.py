@@ -46,6 +46,7 @@ from jax.flatten_util import ravel_pytree
 from .._differences import forward_difference_jacobian
 from .._linalg import lu_factor, lu_solve
 from ..multibody._simulate import _status
+from ._replay import replayed_solve
 
 #: The additive Runge-Kutta methods of :class:`LinearImplicitARK`, by name: Diffrax's solver
 #: whose tableaux and dense output it takes, and its order.
@@ -210,6 +211,17 @@ def _with_matrix(solver, matrix):
     return solver
 
 
+def _segment_terms(params):
+    """The split of a segment for :func:`._replay.replayed_solve`: ``params`` the field, the
+    segment's start state and time and the split's matrix."""
+    field, y0, t0, jacobian = params
+    return linearised_split(field, y0, t0, jacobian)
+
+
+def _plain_terms(params):
+    return diffrax.ODETerm(params[0])
+
+
 class SegmentedSolution(eqx.Module):
     """What :func:`relinearised_solve` returns: ``ys`` the states at the save times (inf
     after a stop, as Diffrax fills them), ``status`` (0 completed, 1 stopped by an event, 2
@@ -234,15 +246,15 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
     (``explicit``: the flat indices of the states it keeps explicit; ``solver`` default
     :func:`imex_solver`); without it ``field`` itself (``solver`` default
     Tsit5). A segment starts with the mean accepted step of the one before (``dt0`` the
-    first); ``controller``, ``event``, ``max_steps`` (per segment) and ``adjoint`` go to
-    every segment's ``diffeqsolve``. After a stop (an event or a failure) the later segments
+    first); ``controller``, ``event`` and ``max_steps`` (per segment) go to every segment's
+    ``diffeqsolve``, and ``adjoint`` too when given; by default reverse mode replays each
+    segment's accepted steps (:func:`._replay.replayed_solve`). After a stop (an event or a failure) the later segments
     are skipped. One compiled segment solve, run in a ``lax.scan``: the program holds the
     vector field as often as one solve does."""
     if solver is None:
         solver = imex_solver() if split else diffrax.Tsit5()
     edges = jnp.linspace(0.0, t1, segments + 1)
     n_conditions = len(jax.tree.leaves(event.cond_fn, is_leaf=callable))
-    options = {} if adjoint is None else {"adjoint": adjoint}
     # the solver steps one flat vector (fewer operations per step than a pytree state)
     x0, unravel = ravel_pytree(y0)
 
@@ -253,18 +265,24 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
         lambda c: lambda t, x, args, **kw: c(t, unravel(x), args, **kw), event.cond_fn, is_leaf=callable))
 
     def run(y, dt, a, b):
-        if split:
-            jacobian = split_jacobian(flat_field, y, a, explicit)
-            terms, seg_solver = linearised_split(flat_field, y, a, jacobian), _with_matrix(solver, jacobian)
+        save_ts = jnp.clip(ts, a, b)
+        jacobian = split_jacobian(flat_field, y, a, explicit) if split else None
+        seg_solver = _with_matrix(solver, jacobian) if split else solver
+        if adjoint is None:
+            # the field's closed-over parameters made explicit, so the replay differentiates them
+            params = (eqx.filter_closure_convert(flat_field, a, y, None), y, a, jacobian)
+            sol = replayed_solve(_segment_terms if split else _plain_terms, params, y, a, b, dt, save_ts,
+                                 solver=seg_solver, controller=controller, event=flat_event, max_steps=max_steps)
+            ys, y_end, result, event_mask, stats = sol.ys, sol.y_end, sol.result, sol.event_mask, sol.stats
         else:
-            terms, seg_solver = diffrax.ODETerm(flat_field), solver
-        sol = diffrax.diffeqsolve(terms, seg_solver, a, b, dt, y, saveat=diffrax.SaveAt(ts=jnp.clip(ts, a, b), t1=True),
-                                  event=flat_event, stepsize_controller=controller, max_steps=max_steps, throw=False,
-                                  **options)
-        counts = jnp.stack([jnp.asarray(sol.stats[k], jnp.int32) for k in _COUNTS])
-        mask = jnp.stack([jnp.asarray(m, bool) for m in jax.tree.leaves(sol.event_mask)])
-        status = _status(sol.result).astype(jnp.int32)
-        return sol.ys[:-1], sol.ys[-1], status, mask, counts
+            terms = linearised_split(flat_field, y, a, jacobian) if split else diffrax.ODETerm(flat_field)
+            sol = diffrax.diffeqsolve(terms, seg_solver, a, b, dt, y, saveat=diffrax.SaveAt(ts=save_ts, t1=True),
+                                      event=flat_event, stepsize_controller=controller, max_steps=max_steps,
+                                      throw=False, adjoint=adjoint)
+            ys, y_end, result, event_mask, stats = sol.ys[:-1], sol.ys[-1], sol.result, sol.event_mask, sol.stats
+        counts = jnp.stack([jnp.asarray(stats[k], jnp.int32) for k in _COUNTS])
+        mask = jnp.stack([jnp.asarray(m, bool) for m in jax.tree.leaves(event_mask)])
+        return ys, y_end, _status(result).astype(jnp.int32), mask, counts
 
     def skip(y, dt, a, b):
         del dt, a, b
