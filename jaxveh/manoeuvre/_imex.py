@@ -46,7 +46,7 @@ from jax.flatten_util import ravel_pytree
 from .._differences import forward_difference_jacobian
 from .._linalg import lu_factor, lu_solve
 from ..multibody._simulate import _status
-from ._replay import replayed_solve
+from ._replay import COUNTS, replayed_solve
 
 #: The additive Runge-Kutta methods of :class:`LinearImplicitARK`, by name: Diffrax's solver
 #: whose tableaux and dense output it takes, and its order.
@@ -234,7 +234,6 @@ class SegmentedSolution(eqx.Module):
     stats: dict
 
 
-_COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
 
 
 def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, dt0, max_steps: int,
@@ -280,14 +279,14 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
                                       event=flat_event, stepsize_controller=controller, max_steps=max_steps,
                                       throw=False, adjoint=adjoint)
             ys, y_end, result, event_mask, stats = sol.ys[:-1], sol.ys[-1], sol.result, sol.event_mask, sol.stats
-        counts = jnp.stack([jnp.asarray(stats[k], jnp.int32) for k in _COUNTS])
+        counts = jnp.stack([jnp.asarray(stats[k], jnp.int32) for k in COUNTS])
         mask = jnp.stack([jnp.asarray(m, bool) for m in jax.tree.leaves(event_mask)])
         return ys, y_end, _status(result).astype(jnp.int32), mask, counts
 
     def skip(y, dt, a, b):
         del dt, a, b
         return (jnp.full(ts.shape + y.shape, jnp.inf, y.dtype), y, jnp.asarray(0, jnp.int32),
-                jnp.zeros(n_conditions, bool), jnp.zeros(len(_COUNTS), jnp.int32))
+                jnp.zeros(n_conditions, bool), jnp.zeros(len(COUNTS), jnp.int32))
 
     def segment(carry, ab):
         y, dt, status = carry
@@ -306,5 +305,5 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
         # each save time from the segment it falls in (the last one holds t1)
         which = jnp.clip(jnp.searchsorted(edges, ts, side="right") - 1, 0, segments - 1)
         ys = ys[which, jnp.arange(ts.shape[0])]
-    stats = {k: counts[:, i].sum() for i, k in enumerate(_COUNTS)} | {"max_steps": max_steps}
+    stats = {k: counts[:, i].sum() for i, k in enumerate(COUNTS)} | {"max_steps": max_steps}
     return SegmentedSolution(ys=jax.vmap(unravel)(ys), status=status, event_mask=tuple(masks.any(axis=0)), stats=stats)

@@ -26,12 +26,14 @@ import jax.numpy as jnp
 #: Accepted steps a differentiated solve keeps for its reverse pass (per solve: per segment of
 #: :func:`._imex.relinearised_solve`); each costs one state of memory.
 REPLAY_STEPS = 4096
+#: Diffrax's step counts a :class:`ReplayedSolution` reports.
+COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
 
 
 class ReplayedSolution(eqx.Module):
     """What :func:`replayed_solve` returns: ``ys`` the states at ``ts`` (inf where the solve
     stopped before), ``y_end`` the last state, Diffrax's ``result``, ``event_mask`` and
-    ``stats``."""
+    ``stats`` (its :data:`COUNTS`)."""
 
     ys: jax.Array
     y_end: jax.Array
@@ -46,7 +48,7 @@ def _diffeqsolve(terms, solver, t0, t1, dt0, y0, ts, controller, event, max_step
                               stepsize_controller=controller, max_steps=max_steps, throw=False)
     ys = sol.ys[0]
     out = ReplayedSolution(ys=ys[:-1], y_end=ys[-1], result=sol.result, event_mask=sol.event_mask,
-                           stats=dict(sol.stats))
+                           stats={k: sol.stats[k] for k in COUNTS})
     return out, (sol.ts[1], sol.ys[1]) if record_steps else None
 
 
@@ -85,6 +87,10 @@ def _replayed_bwd(residuals, grad_out, perturbed, params_and_y0, terms_fn, solve
     ct_end = _zeros_or(grad_out.y_end, y0)
     # the step whose dense output saved each save time (Diffrax: the first step ending at or after it)
     saved_in = jnp.searchsorted(step_ts, ts, side="left")
+    # Diffrax writes the final state into the slot after the last save time reached: the t1 slot
+    # of a completed solve, the first unreached save time's of a stopped one
+    reached = jnp.sum(saved_in < accepted)
+    ct_final = jnp.concatenate([ct_ys, ct_end[None]])[reached]
     diff_params, static_params = eqx.partition(params, perturbed[0])
 
     def step_and_saves(diff, y, t_start, t_end):
@@ -100,10 +106,10 @@ def _replayed_bwd(residuals, grad_out, perturbed, params_and_y0, terms_fn, solve
         y = jnp.where(n == 0, y0, step_ys[jnp.maximum(n - 1, 0)])
         t_start = jnp.where(n == 0, t0, step_ts[jnp.maximum(n - 1, 0)])
         _, vjp = jax.vjp(lambda d, x: step_and_saves(d, x, t_start, step_ts[n]), diff_params, y)
-        g_diff, g_y = vjp((ct_y, jnp.where((saved_in == n)[:, None], ct_ys, 0.0)))
+        g_diff, g_y = vjp((ct_y, jnp.where(((saved_in == n) & (saved_in < accepted))[:, None], ct_ys, 0.0)))
         return g_y, jax.tree.map(jnp.add, ct_diff, g_diff)
 
-    ct_y0, ct_diff = jax.lax.fori_loop(0, accepted, back, (ct_end, jax.tree.map(jnp.zeros_like, diff_params)))
+    ct_y0, ct_diff = jax.lax.fori_loop(0, accepted, back, (ct_final, jax.tree.map(jnp.zeros_like, diff_params)))
     return ct_diff, (ct_y0 if perturbed[1] else None)
 
 
