@@ -15,7 +15,8 @@ neighbours, steady value the mean over the last ``settle_s``).
 chose held fixed, so a derivative is the exact one to the integration's tolerance (hence the
 tight default ``rtol``). The adjoint sets which mode works: ``reverse=False`` (default)
 integrates with ``diffrax.ForwardMode`` (values, ``jax.jvp``, ``jax.jacfwd``: what study
-files use); ``reverse=True`` with Diffrax's recursive checkpointing (``jax.grad``).
+files use); ``reverse=True`` with the fast car's replay of the accepted steps (``jax.grad``;
+the same derivative as Diffrax's recursive checkpointing, docs/manoeuvre.md).
 
 A run that stops early (the car spins or rolls, the solver fails) or whose start is not
 found gives NaN.

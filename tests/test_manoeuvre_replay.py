@@ -1,9 +1,9 @@
 """Reverse mode by replaying the accepted steps (jaxveh.manoeuvre._replay): the same solution
 and, to round-off, the same derivative as Diffrax's recursive checkpointing (Diffrax holds the
 step sizes out of differentiation, so both differentiate the same sequence of steps), for
-the linear-implicit IMEX step and an explicit one, with an event stopping the run, under
-``vmap``, and through the car's segmented solve; a solve past the replay's step budget is
-refused by name in the reverse pass."""
+the linear-implicit IMEX step and an explicit one, with steps ending at a jump of the field
+and an event stopping the run, under ``vmap``, and through the car's segmented solve; a
+solve past the replay's step budget is refused by name in the reverse pass."""
 
 import diffrax
 import jax
@@ -22,12 +22,22 @@ P0 = {"k": jnp.asarray(500.0), "c": jnp.asarray(0.02)}
 TS = jnp.concatenate([jnp.linspace(0.0, 1.5, 16), jnp.asarray([2.0])])
 
 
+#: a jump of the forcing (s), where steps end (Diffrax's ``jump_ts``)
+JUMP = 0.77
+
+
 def _field(t, y, p):
-    """A stiff oscillator (``k`` rad/s, damping ratio ``c``) coupled to a forced pendulum."""
+    """A stiff oscillator (``k`` rad/s, damping ratio ``c``) coupled to a pendulum forced by a
+    sine and a step at :data:`JUMP` (a field discontinuous in time, as the car's steering
+    input's derivatives are at its kinks)."""
     x, v, q, w = y
     k, c = p["k"], p["c"]
     return jnp.stack([v, -k**2 * (x - 0.01 * jnp.sin(q)) - 2 * c * k * v, w,
-                      -10.0 * jnp.sin(q) + x + 0.5 * jnp.sin(3.0 * t)])
+                      -10.0 * jnp.sin(q) + x + 0.5 * jnp.sin(3.0 * t) + jnp.where(t >= JUMP, 2.0 * jnp.cos(q), 0.0)])
+
+
+def _controller():
+    return diffrax.PIDController(rtol=1e-6, atol=1e-8, jump_ts=jnp.asarray([JUMP]))
 
 
 def _split_terms(params):
@@ -41,7 +51,7 @@ def _plain_terms(params):
 
 def _solve(p, y0, method: str, replay: bool, stop_below: float):
     """``(ys at TS, final state)`` of the test system from ``y0`` to t = 2 s."""
-    controller = diffrax.PIDController(rtol=1e-6, atol=1e-8)
+    controller = _controller()
     event = diffrax.Event(lambda t, y, args, **kw: y[2] < stop_below)
     if method == "tsit5":
         terms_fn, solver, params = _plain_terms, diffrax.Tsit5(), (p,)
@@ -101,7 +111,7 @@ def test_relinearised_solve_replays_as_diffrax_differentiates():
 
     def loss(scale, adjoint):
         sol = relinearised_solve(lambda t, y, args: _field(t, y, {"k": 500.0 * scale, "c": P0["c"]}), Y0, 2.0, ts,
-                                 segments=3, controller=diffrax.PIDController(rtol=1e-6, atol=1e-8),
+                                 segments=3, controller=_controller(),
                                  event=diffrax.Event(lambda t, y, args, **kw: y[2] < -5.0), dt0=1e-3,
                                  max_steps=100_000, adjoint=adjoint)
         return jnp.sum(sol.ys[:, 2] ** 2) + sol.ys[-1, 0]

@@ -24,8 +24,8 @@ import jax
 import jax.numpy as jnp
 
 #: Accepted steps a differentiated solve keeps for its reverse pass (per solve: per segment of
-#: :func:`._imex.relinearised_solve`); each costs one state of memory.
-REPLAY_STEPS = 4096
+#: :func:`._imex.relinearised_solve`); each costs one state of memory (the fast car: 6.7 MB in all).
+REPLAY_STEPS = 16_384
 #: Diffrax's step counts a :class:`ReplayedSolution` reports.
 COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
 
@@ -73,20 +73,34 @@ def _zeros_or(cotangent, like):
     return jnp.zeros_like(like) if cotangent is None else cotangent
 
 
+def _step_times(t0, recorded, jump_ts):
+    """Each accepted step's start and end (s) from the times Diffrax records: a step cut short
+    before a jump time ends just before it (``prevbefore``) and the next starts just after,
+    where Diffrax records that start as the step's end."""
+    starts = jnp.concatenate([jnp.reshape(t0, (1,)).astype(recorded.dtype), recorded[:-1]])
+    if jump_ts is None:
+        return starts, recorded
+    jump_ts = jnp.asarray(jump_ts, recorded.dtype)
+    next_jump = jnp.min(jnp.where(jump_ts[None, :] > starts[:, None], jump_ts[None, :], jnp.inf), axis=1)
+    before_jump = jnp.nextafter(next_jump, -jnp.inf)
+    return starts, jnp.where(jnp.isfinite(next_jump), jnp.minimum(recorded, before_jump), recorded)
+
+
 @_replayed.def_bwd
 def _replayed_bwd(residuals, grad_out, perturbed, params_and_y0, terms_fn, solver, t0, t1, dt0, ts, controller,
                   event, max_steps):
-    del t1, dt0, controller, event
-    step_ts, step_ys, accepted, capped = residuals
+    del t1, dt0, event
+    recorded_ts, step_ys, accepted, capped = residuals
     params, y0 = params_and_y0
     step_ys = eqx.error_if(step_ys, capped, f"the reverse pass replays at most {min(max_steps, REPLAY_STEPS)} accepted "
                                             "steps per solve (jaxveh.manoeuvre._replay.REPLAY_STEPS) and this solve "
                                             "took more: differentiate with more linearisations (segments), or pass "
                                             "adjoint=diffrax.RecursiveCheckpointAdjoint()")
+    starts, ends = _step_times(t0, recorded_ts, getattr(controller, "jump_ts", None))
     ct_ys = _zeros_or(grad_out.ys, jnp.zeros(ts.shape + y0.shape, y0.dtype))
     ct_end = _zeros_or(grad_out.y_end, y0)
     # the step whose dense output saved each save time (Diffrax: the first step ending at or after it)
-    saved_in = jnp.searchsorted(step_ts, ts, side="left")
+    saved_in = jnp.searchsorted(ends, ts, side="left")
     # Diffrax writes the final state into the slot after the last save time reached: the t1 slot
     # of a completed solve, the first unreached save time's of a stopped one
     reached = jnp.sum(saved_in < accepted)
@@ -104,8 +118,7 @@ def _replayed_bwd(residuals, grad_out, perturbed, params_and_y0, terms_fn, solve
         ct_y, ct_diff = carry
         n = accepted - 1 - i
         y = jnp.where(n == 0, y0, step_ys[jnp.maximum(n - 1, 0)])
-        t_start = jnp.where(n == 0, t0, step_ts[jnp.maximum(n - 1, 0)])
-        _, vjp = jax.vjp(lambda d, x: step_and_saves(d, x, t_start, step_ts[n]), diff_params, y)
+        _, vjp = jax.vjp(lambda d, x: step_and_saves(d, x, starts[n], ends[n]), diff_params, y)
         g_diff, g_y = vjp((ct_y, jnp.where(((saved_in == n) & (saved_in < accepted))[:, None], ct_ys, 0.0)))
         return g_y, jax.tree.map(jnp.add, ct_diff, g_diff)
 

@@ -239,8 +239,10 @@ def manoeuvre_channels(car, manoeuvre: Manoeuvre, ts, *, form: str, trim=None, s
     """``(channels, stats, status)`` of ``manoeuvre`` on ``car`` at the save times ``ts`` (s)
     in ``form`` ("fast" or "library"), from ``trim`` (default: :func:`straight_trim`): a
     pure function of the car and the manoeuvre (jit, vmap and grad through it; reverse
-    mode uses Diffrax's recursive checkpointing; forward mode, ``jax.jvp`` and ``jax.jacfwd``,
-    needs ``adjoint=diffrax.ForwardMode()``, fast form only). ``stats``: Diffrax's counts, ``event``
+    mode replays the accepted steps in the fast form (:func:`._replay.replayed_solve`; a
+    Diffrax ``adjoint`` instead when given) and uses Diffrax's recursive checkpointing in
+    the library form; forward mode, ``jax.jvp`` and ``jax.jacfwd``, needs
+    ``adjoint=diffrax.ForwardMode()``, fast form only). ``stats``: Diffrax's counts, ``event``
     (0 or the 1-based index into :data:`EVENTS`) and ``valid`` (save times reached);
     ``status``: 0 completed, 1 stopped by an event, 2 solver failure. ``freeze_steps``
     (library form): hold the projection matrices for that many steps
