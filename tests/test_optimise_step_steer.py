@@ -164,7 +164,7 @@ def test_study_jacobian_equals_central_differences(design, evaluated):
 @pytest.mark.slow
 def test_reverse_mode_gradient_equals_central_differences(car):
     """``reverse=True``: ``jax.grad`` of the overshoot with respect to the front anti-roll
-    bar rate (Diffrax's recursive checkpointing) equals a central difference of the same
+    bar rate (the replay of the accepted steps) equals a central difference of the same
     function (relative step 1e-3): 1e-4."""
 
     def overshoot(rate):
