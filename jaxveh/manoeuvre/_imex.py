@@ -219,6 +219,7 @@ def _segment_terms(params):
 
 
 def _plain_terms(params):
+    """The unsplit field of a segment for :func:`._replay.replayed_solve`."""
     return diffrax.ODETerm(params[0])
 
 
@@ -247,8 +248,8 @@ def relinearised_solve(field, y0, t1, ts, *, segments: int, controller, event, d
     Tsit5). A segment starts with the mean accepted step of the one before (``dt0`` the
     first); ``controller``, ``event`` and ``max_steps`` (per segment) go to every segment's
     ``diffeqsolve``, and ``adjoint`` too when given; by default reverse mode replays each
-    segment's accepted steps (:func:`._replay.replayed_solve`). After a stop (an event or a failure) the later segments
-    are skipped. One compiled segment solve, run in a ``lax.scan``: the program holds the
+    segment's accepted steps (:func:`._replay.replayed_solve`). After a stop (an event or a
+    failure) the later segments are skipped. One compiled segment solve, run in a ``lax.scan``: the program holds the
     vector field as often as one solve does."""
     if solver is None:
         solver = imex_solver() if split else diffrax.Tsit5()
