@@ -119,7 +119,7 @@ def _replayed_bwd(residuals, grad_out, perturbed, params_and_y0, terms_fn, solve
         n = accepted - 1 - i
         y = jnp.where(n == 0, y0, step_ys[jnp.maximum(n - 1, 0)])
         _, vjp = jax.vjp(lambda d, x: step_and_saves(d, x, starts[n], ends[n]), diff_params, y)
-        g_diff, g_y = vjp((ct_y, jnp.where(((saved_in == n) & (saved_in < accepted))[:, None], ct_ys, 0.0)))
+        g_diff, g_y = vjp((ct_y, jnp.where((saved_in == n)[:, None], ct_ys, 0.0)))
         return g_y, jax.tree.map(jnp.add, ct_diff, g_diff)
 
     ct_y0, ct_diff = jax.lax.fori_loop(0, accepted, back, (ct_final, jax.tree.map(jnp.zeros_like, diff_params)))
