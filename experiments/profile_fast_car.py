@@ -8,7 +8,13 @@ the ``Kinematics`` for the force elements, each of the library car's force eleme
 fast car's four-corner push-rod suspension (:mod:`jaxveh.vehicle._fast_suspension`) and the
 full evaluation (``q_dot``, ``u_dot``, ``aux_dot``).
 
-    .venv/bin/python experiments/profile_fast_car.py [--json results/profile_fast_car.json]
+``--by-source N`` also attributes the full evaluation's operations to the innermost
+``jaxveh`` function on their trace stack (from the stack-frame tables XLA prints with the
+compiled program) and prints the ``N`` functions with the most: where to cut operations.
+
+    .venv/bin/python experiments/profile_fast_car.py [--json results/profile_fast_car.json] [--by-source 30]
+
+``--json`` writes ``{"pieces": [...], "full_by_source": {...} or null}``.
 """
 
 import argparse
@@ -41,6 +47,59 @@ def entry_ops(f, *args) -> collections.Counter:
     text = jax.jit(f).lower(*args).compile().as_text()
     entry = text.split("\nENTRY")[1]
     return collections.Counter(re.findall(r"= \S+ ([\w-]+)\(", entry))
+
+
+#: Operations of the ENTRY computation that are bookkeeping, not kernels.
+BOOKKEEPING = ("parameter", "constant", "get-tuple-element", "tuple", "bitcast")
+
+
+def _stack_tables(text: str) -> dict[int, tuple[str, str, int, int]]:
+    """``{frame id: (file, function, line, parent frame id)}`` from the tables at the end of
+    a compiled program's text (empty when this XLA prints none)."""
+    sections: dict[str, list[str]] = {}
+    current = None
+    for line in text.splitlines():
+        if line in ("FileNames", "FunctionNames", "FileLocations", "StackFrames"):
+            current = sections.setdefault(line, [])
+        elif current is not None and re.match(r"\d+ ", line):
+            current.append(line)
+        else:
+            current = None
+    files = {int(m[1]): m[2] for m in (re.match(r'(\d+) "(.*)"', x) for x in sections.get("FileNames", []))}
+    functions = {int(m[1]): m[2] for m in (re.match(r'(\d+) "(.*)"', x) for x in sections.get("FunctionNames", []))}
+    locations = {int(m[1]): (files[int(m[2])], functions[int(m[3])], int(m[4])) for m in (
+        re.match(r"(\d+) \{file_name_id=(\d+) function_name_id=(\d+) line=(\d+)", x)
+        for x in sections.get("FileLocations", []))}
+    frames = {}
+    for x in sections.get("StackFrames", []):
+        m = re.match(r"(\d+) \{file_location_id=(\d+)(?: parent_frame_id=(\d+))?", x)
+        frames[int(m[1])] = (*locations[int(m[2])], int(m[3] or 0))
+    return frames
+
+
+def ops_by_source(f, *args) -> collections.Counter:
+    """Top-level operations of the compiled ``f`` by the innermost ``jaxveh`` function on
+    their trace stack (``"module.py:function"``; ``"other"`` where none is recorded)."""
+    text = jax.jit(f).lower(*args).compile().as_text()
+    frames = _stack_tables(text)
+    entry = text.split("\nENTRY")[1].split("\n}\n")[0]
+    counts: collections.Counter = collections.Counter()
+    for line in entry.splitlines():
+        kind = re.search(r"= \S+ ([\w-]+)\(", line)
+        if not kind or kind[1] in BOOKKEEPING:
+            continue
+        frame = re.search(r"stack_frame_id=(\d+)", line)
+        source, seen = "other", set()
+        fid = int(frame[1]) if frame else 0
+        while fid in frames and fid not in seen:
+            seen.add(fid)
+            file, function, _, parent = frames[fid]
+            if "/jaxveh/" in file and "site-packages" not in file:
+                source = f"{file.split('/jaxveh/')[-1]}:{function}"
+                break
+            fid = parent
+        counts[source] += 1
+    return counts
 
 
 def loop_time(f, *args, repeats: int) -> float:
@@ -110,8 +169,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path, help="also write the table as JSON here")
     parser.add_argument("--repeats", type=int, default=5, help="timed loops per piece (best taken)")
+    parser.add_argument("--by-source", type=int, default=0, metavar="N",
+                        help="also list the N jaxveh functions with the most operations in the full evaluation")
     args = parser.parse_args()
-    rows = []
+    rows, sources = [], None
     print(f"{'piece':28s} {'ops':>5s} {'us':>8s}  by kind")
     for name, f, a in pieces():
         ops = entry_ops(f, *a)
@@ -119,9 +180,16 @@ def main():
         kinds = {k: v for k, v in ops.most_common() if k != "parameter"}
         rows.append({"piece": name, "ops": sum(kinds.values()), "us": us, "by_kind": kinds})
         print(f"{name:28s} {sum(kinds.values()):5d} {us:8.1f}  {dict(list(kinds.items())[:6])}", flush=True)
+        if name == "full" and args.by_source:
+            sources = ops_by_source(f, *a)
+    if sources is not None:
+        print(f"\nfull evaluation, operations by source ({sum(sources.values())} in all)")
+        for source, n in sources.most_common(args.by_source):
+            print(f"{n:5d}  {source}")
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(rows, indent=1))
+        out = {"pieces": rows, "full_by_source": None if sources is None else dict(sources.most_common())}
+        args.json.write_text(json.dumps(out, indent=1))
 
 
 if __name__ == "__main__":
