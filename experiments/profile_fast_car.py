@@ -42,9 +42,13 @@ from jaxveh.vehicle import (
 LOOP = 200
 
 
-def entry_ops(f, *args) -> collections.Counter:
-    """Top-level operations of the compiled ``f`` (its ENTRY computation) by kind."""
-    text = jax.jit(f).lower(*args).compile().as_text()
+def compiled_text(f, *args) -> str:
+    """The text of ``f`` compiled for ``args`` (XLA's optimised program)."""
+    return jax.jit(f).lower(*args).compile().as_text()
+
+
+def entry_ops(text: str) -> collections.Counter:
+    """Top-level operations of a compiled program (its ENTRY computation) by kind."""
     entry = text.split("\nENTRY")[1]
     return collections.Counter(re.findall(r"= \S+ ([\w-]+)\(", entry))
 
@@ -77,10 +81,9 @@ def _stack_tables(text: str) -> dict[int, tuple[str, str, int, int]]:
     return frames
 
 
-def ops_by_source(f, *args) -> collections.Counter:
-    """Top-level operations of the compiled ``f`` by the innermost ``jaxveh`` function on
+def ops_by_source(text: str) -> collections.Counter:
+    """Top-level operations of a compiled program by the innermost ``jaxveh`` function on
     their trace stack (``"module.py:function"``; ``"other"`` where none is recorded)."""
-    text = jax.jit(f).lower(*args).compile().as_text()
     frames = _stack_tables(text)
     entry = text.split("\nENTRY")[1].split("\n}\n")[0]
     counts: collections.Counter = collections.Counter()
@@ -175,13 +178,14 @@ def main():
     rows, sources = [], None
     print(f"{'piece':28s} {'ops':>5s} {'us':>8s}  by kind")
     for name, f, a in pieces():
-        ops = entry_ops(f, *a)
+        text = compiled_text(f, *a)
+        ops = entry_ops(text)
         us = loop_time(f, *a, repeats=args.repeats) * 1e6
         kinds = {k: v for k, v in ops.most_common() if k != "parameter"}
         rows.append({"piece": name, "ops": sum(kinds.values()), "us": us, "by_kind": kinds})
         print(f"{name:28s} {sum(kinds.values()):5d} {us:8.1f}  {dict(list(kinds.items())[:6])}", flush=True)
         if name == "full" and args.by_source:
-            sources = ops_by_source(f, *a)
+            sources = ops_by_source(text)
     if sources is not None:
         print(f"\nfull evaluation, operations by source ({sum(sources.values())} in all)")
         for source, n in sources.most_common(args.by_source):
