@@ -101,6 +101,7 @@ def _replayed_bwd(residuals, grad_out, perturbed, params_and_y0, terms_fn, solve
     ct_end = _zeros_or(grad_out.y_end, y0)
     # the step whose dense output saved each save time (Diffrax: the first step ending at or after it)
     saved_in = jnp.searchsorted(ends, ts, side="left")
+    accepted = accepted.astype(saved_in.dtype)  # Diffrax's count is int64 under vmap
     # Diffrax writes the final state into the slot after the last save time reached: the t1 slot
     # of a completed solve, the first unreached save time's of a stopped one
     reached = jnp.sum(saved_in < accepted)
