@@ -14,6 +14,7 @@ size they have in a plain run (docs/optimise.md: jaxlib's batched-LAPACK thread 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 import optimistix as optx
 from jax.flatten_util import ravel_pytree
 from jaxtyping import Array, Float
@@ -25,12 +26,15 @@ from ._linalg import lu_factor, lu_solve
 RELATIVE_STEP = 1.5e-8
 
 
-def _differences(fn, x, with_base: bool):
-    """``(values, h)``: ``fn`` (returning a pytree) at ``x`` plus each step ``h_j e_j``, and at
-    ``x`` itself as the last row when ``with_base``, in one ``lax.map``."""
+def _differences(fn, x, with_base: bool, columns=None):
+    """``(values, h)``: ``fn`` (returning a pytree) at ``x`` plus each step ``h_j e_j`` (``j`` in
+    ``columns``, static; default all), and at ``x`` itself as the last row when ``with_base``,
+    in one ``lax.map``."""
     n = x.shape[0]
     h = (x + RELATIVE_STEP * jnp.maximum(jnp.abs(x), 1.0)) - x
     steps = jnp.diag(h)
+    if columns is not None:
+        steps, h = steps[np.asarray(columns, int)], h[np.asarray(columns, int)]
     if with_base:
         steps = jnp.concatenate([steps, jnp.zeros((1, n), x.dtype)])
     return jax.lax.map(lambda step: fn(x + step), steps), h
@@ -40,14 +44,23 @@ def _quotients(values, base, h):
     return ((values[: h.shape[0]] - base[None, :]) / h[:, None]).T
 
 
-def forward_difference_jacobian(fn, x: Float[Array, " n"], fx=None) -> Float[Array, "m n"]:
+def forward_difference_jacobian(fn, x: Float[Array, " n"], fx=None, skip: tuple[int, ...] = ()
+                                ) -> Float[Array, "m n"]:
     """``d fn / d x`` (m, n) at ``x`` (n,) by forward differences, steps
     ``RELATIVE_STEP * max(|x_j|, 1)`` (each rounded to one the floats represent). One
     evaluation per column, plus one at ``x`` unless its value ``fx`` is given, in a
     ``lax.map``: the program holds ``fn`` once. Relative error about 1e-8 where ``fn`` is
-    smooth; across a kink the slope of the side the step goes to."""
-    values, h = _differences(fn, x, fx is None)
-    return _quotients(values, values[-1] if fx is None else fx, h)
+    smooth; across a kink the slope of the side the step goes to. The columns ``skip``
+    (indices) are zero, not evaluated."""
+    n = x.shape[0]
+    if any(not 0 <= j < n for j in skip):
+        raise ValueError(f"skip = {skip} must hold column indices in [0, {n})")
+    columns = [j for j in range(n) if j not in set(skip)]
+    values, h = _differences(fn, x, fx is None, columns if skip else None)
+    quotients = _quotients(values, values[-1] if fx is None else fx, h)
+    if not skip:
+        return quotients
+    return jnp.zeros((quotients.shape[0], n), quotients.dtype).at[:, np.asarray(columns, int)].set(quotients)
 
 
 class _NewtonState(eqx.Module):

@@ -6,6 +6,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
+import pytest
 
 import jaxveh  # noqa: F401  (float64)
 from jaxveh._differences import DifferenceNewton, forward_difference_jacobian
@@ -31,6 +32,26 @@ def test_forward_difference_jacobian():
         close(batched[k], xs[k])
     kink = forward_difference_jacobian(lambda v: jnp.abs(v), jnp.asarray([0.0, -1.0]))
     np.testing.assert_allclose(kink, np.diag([1.0, -1.0]), rtol=1e-6)
+
+
+def test_forward_difference_jacobian_skips_columns():
+    """Skipped columns are zero and not evaluated (one evaluation fewer each); the others as
+    without skipping; an index outside the columns is refused by name."""
+
+    def fn(x):
+        return jnp.stack([x[0] * x[1], x[1] ** 2, jnp.sin(x[2])])
+
+    x = jnp.asarray([0.5, 2.0, 1.0])
+    full = forward_difference_jacobian(fn, x)
+    skipped = forward_difference_jacobian(fn, x, skip=(1,))
+    np.testing.assert_array_equal(skipped[:, 1], 0.0)
+    np.testing.assert_array_equal(skipped[:, [0, 2]], full[:, [0, 2]])
+    lengths = [jax.make_jaxpr(lambda v, s=s: forward_difference_jacobian(fn, v, skip=s))(x).eqns
+               for s in ((), (0, 2))]
+    maps = [[e for e in eqns if e.primitive.name == "scan"][0].params["length"] for eqns in lengths]
+    assert maps == [4, 2], maps
+    with pytest.raises(ValueError, match=r"skip = \(3,\) must hold column indices in \[0, 3\)"):
+        forward_difference_jacobian(fn, x, skip=(3,))
 
 
 def _system(y, args):
