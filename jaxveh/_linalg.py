@@ -10,6 +10,17 @@ use the pool), and differentiate as linear solves (:func:`jax.lax.custom_linear_
 forward and reverse mode, the factorisation itself never differentiated). Unbatched it is
 the plain LAPACK call.
 
+The IMEX solver's stages solve ``(I - s A) x = b`` with one matrix ``A`` per segment and one
+shift ``s`` per step (:func:`shifted_factor`, :func:`shifted_solve`). Unbatched that is an LU
+factorisation per step and two triangular solves per stage (LAPACK). Under ``jax.vmap`` the
+members' factorisations and solves one after the other cost more than the car's field
+itself in a batch, so there each member's ``A`` is decomposed once per segment, ``A = V
+diag(lambda) V^-1`` (:func:`spectral_form`), and a stage solve is two matrix-vector products,
+batched: ``x = V diag(1 / (1 - s lambda)) V^-1 b`` (docs/manoeuvre.md, "Solvers"). A member
+whose decomposition is refused (a defective or ill-conditioned ``V``) sends the batch back to
+the LU loop. An unbatched program never computes the decomposition
+(:func:`jax.custom_batching.custom_vmap` picks the path).
+
 The same treatment of the fast car's Cholesky solve failed: the skid-pad program (a
 Newton solve whose Jacobian is a vmapped forward-mode pass) then stopped at run time with
 "No registered implementation for untyped custom call to lapack_dpotrf_ffi", so that solve
