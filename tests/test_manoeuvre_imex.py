@@ -337,9 +337,9 @@ def test_manoeuvre_channels_takes_auto():
 
 
 def test_vmapped_relinearised_solve_equals_single_runs():
-    """Under ``vmap`` the stages are solved with each segment's spectral form (matrix-vector
-    products, jaxveh._linalg) where a single run uses LU: each member takes the steps its own
-    run takes, to the same solution (round-off apart), and its derivative is the same."""
+    """Under ``vmap`` (the stage solves one member after the other, jaxveh._linalg) each
+    member takes the steps its own run takes, to the same solution (round-off apart), and its
+    derivative (the replayed reverse pass, vmapped) is the same."""
     amplitudes = jnp.asarray([0.5, 1.0, 1.5])
     ts = jnp.linspace(0.0, 2.0, 21)
 

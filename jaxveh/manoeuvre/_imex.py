@@ -44,7 +44,7 @@ import numpy as np
 from jax.flatten_util import ravel_pytree
 
 from .._differences import forward_difference_jacobian
-from .._linalg import Spectral, empty_spectral, shifted_factor, shifted_solve, spectral_form
+from .._linalg import lu_factor, lu_solve
 from ..multibody._simulate import _status
 from ._replay import COUNTS, replayed_solve
 
@@ -90,7 +90,6 @@ class LinearImplicitARK(diffrax.AbstractAdaptiveSolver):
     less (docs/manoeuvre.md, "Speed", nineteenth measurement)."""
 
     matrix: jax.Array | None = None
-    spectral: Spectral | None = None
     method: str = eqx.field(static=True, default="kencarp5")
 
     term_structure: ClassVar = diffrax.MultiTerm[tuple[diffrax.AbstractTerm, diffrax.AbstractTerm]]
@@ -129,8 +128,7 @@ class LinearImplicitARK(diffrax.AbstractAdaptiveSolver):
             _tableau_matrices(self.method))
         h = t1 - t0
         stages, n = gamma.shape[0], y0.shape[0]
-        spectral = self.spectral if self.spectral is not None else empty_spectral(matrix)
-        factors = shifted_factor(matrix, spectral, h * gamma[-1])
+        factors = lu_factor(jnp.eye(n, dtype=y0.dtype) - (h * gamma[-1]) * matrix)
 
         def stage(ks, coefficients):
             k_explicit, k_implicit = ks
@@ -138,7 +136,7 @@ class LinearImplicitARK(diffrax.AbstractAdaptiveSolver):
             z = y0 + row_explicit @ k_explicit + row_implicit @ k_implicit
             t = t0 + ci * h
             # diagonal is 0 at the explicit first stage: the solve then returns 0
-            y = z + shifted_solve(factors, (h * diagonal) * implicit.vf(t, z, args))
+            y = z + lu_solve(factors, (h * diagonal) * implicit.vf(t, z, args))
             k_explicit = k_explicit.at[i].set(h * explicit.vf(t, y, args))
             k_implicit = k_implicit.at[i].set(h * implicit.vf(t, y, args))
             return (k_explicit, k_implicit), None
@@ -208,8 +206,7 @@ def _with_matrix(solver, matrix):
     """``solver`` told the split's matrix when it is a :class:`LinearImplicitARK` without one
     (others as they are)."""
     if isinstance(solver, LinearImplicitARK) and solver.matrix is None:
-        return eqx.tree_at(lambda s: (s.matrix, s.spectral), solver, (matrix, spectral_form(matrix)),
-                           is_leaf=lambda x: x is None)
+        return eqx.tree_at(lambda s: s.matrix, solver, matrix, is_leaf=lambda x: x is None)
     return solver
 
 
