@@ -66,15 +66,6 @@ FIRST_STEP = 1e-3
 #: ``q[3]``, first in its flat state) stay out of the IMEX split's implicit part
 #: (:mod:`._imex`): only a closed-loop driver's path or a road reads them, neither stiffly.
 GROUND_POSE = (0, 1, 3)
-
-
-def _explicit_states(car) -> tuple[int, ...]:
-    """The flat indices the fast car's split keeps explicit: :data:`GROUND_POSE` and the four
-    wheel spin angles (``q[10 + modes:]``), on which no equation depends (their columns of the
-    split's matrix are zero either way; left out, the matrix's forward difference evaluates
-    the field four times fewer per linearisation)."""
-    spins = 10 + car.n_modes
-    return GROUND_POSE + tuple(range(spins, spins + 4))
 #: Events that stop a run, by code (0: none): the chassis rolls or pitches beyond
 #: ``ROLLOVER_ANGLE``, or its velocity turns beyond ``SPIN_ANGLE`` from its x axis.
 EVENTS = ("rollover", "spin")
@@ -161,6 +152,15 @@ def _driving(car, manoeuvre: Manoeuvre, trim_rack, pose: int) -> _Driving:
     law = driver_inputs(car, steering, pose, k, trim_rack)
     return _Driving(law, elements + (DriverElement(steering, pose),), jnp.zeros(len(DRIVER_STATES)),
                     lambda t, aux: aux[k])
+
+
+def _explicit_states(car) -> tuple[int, ...]:
+    """The flat indices the fast car's split keeps explicit: :data:`GROUND_POSE` and the four
+    wheel spin angles (``q[10 + modes:]``), on which no equation depends (their columns of the
+    split's matrix are zero either way; left out, the matrix's forward difference evaluates
+    the field four times fewer per linearisation)."""
+    spins = 10 + car.n_modes
+    return GROUND_POSE + tuple(range(spins, spins + 4))
 
 
 def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint, linearisations):
