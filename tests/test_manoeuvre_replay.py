@@ -92,6 +92,41 @@ def test_replay_gives_diffrax_solution_and_derivative(method, stop_below):
         np.testing.assert_allclose(b, a, rtol=1e-9, atol=1e-12 * float(np.max(np.abs(a))))
 
 
+@pytest.mark.parametrize("window", [1, 2])
+def test_replay_takes_a_step_s_save_times_window_by_window(monkeypatch, window):
+    """Steps holding more save times than the reverse pass's window (here 1 or 2 at a time;
+    the dense save times put up to three in a step) give Diffrax's derivative to round-off."""
+    monkeypatch.setattr(_replay, "SAVE_WINDOW", window)
+    dense = jnp.linspace(0.0, 2.0, 2001)
+
+    def loss(p, replay):
+        jacobian = split_jacobian(lambda t, y, args: _field(t, y, p), Y0)
+        solver, params = imex_solver(matrix=jacobian), (p, Y0, jacobian)
+        if replay:
+            ys = replayed_solve(_split_terms, params, Y0, 0.0, 2.0, 1e-3, dense, solver=solver,
+                                controller=_controller(), event=None, max_steps=100_000).ys
+        else:
+            ys = diffrax.diffeqsolve(_split_terms(params), solver, 0.0, 2.0, 1e-3, Y0,
+                                     saveat=diffrax.SaveAt(ts=dense), stepsize_controller=_controller(),
+                                     max_steps=100_000).ys
+        return jnp.sum(ys[:, 2] * jnp.sin(7.0 * dense)) + jnp.sum(ys[:, 0] ** 2)
+
+    held = jnp.bincount(jnp.searchsorted(_accepted_ends(P0), dense, side="left"))
+    assert int(held.max()) > window, "some step should hold more save times than the window"
+    derivatives = [jax.jit(jax.grad(loss), static_argnums=1)(P0, replay) for replay in (False, True)]
+    for a, b in zip(jax.tree.leaves(derivatives[0]), jax.tree.leaves(derivatives[1])):
+        np.testing.assert_allclose(b, a, rtol=1e-9)
+
+
+def _accepted_ends(p):
+    """The accepted steps' end times (s) of the split test system's solve to 2 s."""
+    jacobian = split_jacobian(lambda t, y, args: _field(t, y, p), Y0)
+    sol = diffrax.diffeqsolve(_split_terms((p, Y0, jacobian)), imex_solver(matrix=jacobian), 0.0, 2.0, 1e-3, Y0,
+                              saveat=diffrax.SaveAt(steps=True), stepsize_controller=_controller(),
+                              max_steps=100_000)
+    return sol.ts[jnp.isfinite(sol.ts)]
+
+
 def test_replay_under_vmap():
     """A vmapped batch of derivatives (members taking different numbers of steps) equals the
     members' derivatives one by one."""

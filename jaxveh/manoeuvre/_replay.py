@@ -28,6 +28,9 @@ import jax.numpy as jnp
 REPLAY_STEPS = 16_384
 #: Diffrax's step counts a :class:`ReplayedSolution` reports.
 COUNTS = ("num_steps", "num_accepted_steps", "num_rejected_steps")
+#: Save times the reverse pass takes at a time from a step's dense output (a step holding more
+#: takes several windows).
+SAVE_WINDOW = 8
 
 
 class ReplayedSolution(eqx.Module):
@@ -108,19 +111,42 @@ def _replayed_bwd(residuals, grad_out, perturbed, params_and_y0, terms_fn, solve
     ct_final = jnp.concatenate([ct_ys, ct_end[None]])[reached]
     diff_params, static_params = eqx.partition(params, perturbed[0])
 
-    def step_and_saves(diff, y, t_start, t_end):
+    def step(diff, y, t_start, t_end):
         terms = terms_fn(eqx.combine(diff, static_params))
         state = solver.init(terms, t_start, t_end, y, None)
         y1, _, dense, _, _ = solver.step(terms, t_start, t_end, y, None, state, False)
-        interpolation = solver.interpolation_cls(t0=t_start, t1=t_end, **dense)
-        return y1, jax.vmap(interpolation.evaluate)(jnp.clip(ts, t_start, t_end))
+        return y1, dense
+
+    def saves_cotangent(dense, t_start, t_end, n):
+        """The cotangent of step ``n``'s dense output from the save times it holds (a
+        contiguous run of them: both are sorted), :data:`SAVE_WINDOW` at a time: the
+        interpolation is differentiated at these times only, not at every save time."""
+        first = jnp.searchsorted(saved_in, n, side="left")
+        count = jnp.searchsorted(saved_in, n, side="right") - first
+        window = jnp.arange(SAVE_WINDOW, dtype=first.dtype)
+
+        def evaluate(d, t):
+            return solver.interpolation_cls(t0=t_start, t1=t_end, **d).evaluate(t)
+
+        def chunk(carry):
+            j, ct_dense = carry
+            index = first + j * SAVE_WINDOW + window
+            held = j * SAVE_WINDOW + window < count
+            index = jnp.minimum(index, ts.shape[0] - 1)
+            times = jnp.clip(ts[index], t_start, t_end)
+            _, vjp = jax.vjp(lambda d: jax.vmap(evaluate, in_axes=(None, 0))(d, times), dense)
+            (g,) = vjp(jnp.where(held[:, None], ct_ys[index], 0.0))
+            return j + 1, jax.tree.map(jnp.add, ct_dense, g)
+
+        zero = jax.tree.map(jnp.zeros_like, dense)
+        return jax.lax.while_loop(lambda c: c[0] * SAVE_WINDOW < count, chunk, (jnp.zeros_like(count), zero))[1]
 
     def back(i, carry):
         ct_y, ct_diff = carry
         n = accepted - 1 - i
         y = jnp.where(n == 0, y0, step_ys[jnp.maximum(n - 1, 0)])
-        _, vjp = jax.vjp(lambda d, x: step_and_saves(d, x, starts[n], ends[n]), diff_params, y)
-        g_diff, g_y = vjp((ct_y, jnp.where((saved_in == n)[:, None], ct_ys, 0.0)))
+        (_, dense), vjp = jax.vjp(lambda d, x: step(d, x, starts[n], ends[n]), diff_params, y)
+        g_diff, g_y = vjp((ct_y, saves_cotangent(dense, starts[n], ends[n], n)))
         return g_y, jax.tree.map(jnp.add, ct_diff, g_diff)
 
     ct_y0, ct_diff = jax.lax.fori_loop(0, accepted, back, (ct_final, jax.tree.map(jnp.zeros_like, diff_params)))
