@@ -321,25 +321,24 @@ def _applied_wrenches(car, model, lay, m: CarMotion, a_up, q, rack, forces, torq
 
 
 def _corner_partials(m: CarMotion):
-    """Partial velocities of each corner's upright, ``(G_v, G_w)`` (4, 3, n_c + 2): its
-    velocity and angular velocity (upright axes) with respect to the chassis velocities
-    ``[u, omega, modal rates]``, the corner's travel rate and its wheel's spin rate (a zero
-    column: the spin moves the wheel only). Each corner's velocities depend on no other
+    """Partial velocities of each corner's upright, without their structural zeros: ``P_v``
+    (4, 3, n_c + 1), the wheel centre's velocity in chassis axes with respect to the
+    chassis velocities ``[u, omega, modal rates]`` and the corner's travel rate, and ``P_w``
+    (4, 3, n_c - 2), the upright's angular velocity in upright axes with respect to
+    ``[omega, modal rates]`` and the travel rate (the chassis's ``u`` does not turn it, and a
+    wheel's spin rate moves the wheel only). Each corner's velocities depend on no other
     corner's rates, which :func:`_kane_solve` exploits."""
     sens = m.corners.sens  # d w / d [travel, rack, modes]
-    a_relt = jnp.swapaxes(m.a_rel, 1, 2)
-    eye = jnp.broadcast_to(jnp.eye(3), (4, 3, 3))
     # the wheel centre's velocity in chassis axes: u + omega x r + (dx, dy, travel) rates
+    eye = jnp.broadcast_to(jnp.eye(3), (4, 3, 3))
     lever = -jax.vmap(skew)(m.r_rel)
     modal_v = jnp.concatenate([sens[:, :2, 2:], jnp.zeros((4, 1, sens.shape[2] - 2))], axis=1)
     travel_v = jnp.concatenate([sens[:, :2, 0], jnp.ones((4, 1))], axis=1)[:, :, None]
-    b_v = jnp.concatenate([eye, lever, modal_v, travel_v, jnp.zeros((4, 3, 1))], axis=2)
-    g_v = jnp.einsum("kij,kjl->kil", a_relt, b_v)
+    p_v = jnp.concatenate([eye, lever, modal_v, travel_v], axis=2)
     # the angular velocity: the chassis's plus the angle rates through the rate matrix
     angle_rates = jnp.einsum("kij,kjl->kil", m.e_rel, sens[:, 2:, :])  # (4, 3, 2 + n)
-    g_w = jnp.concatenate([jnp.zeros((4, 3, 3)), a_relt, angle_rates[:, :, 2:], angle_rates[:, :, :1],
-                           jnp.zeros((4, 3, 1))], axis=2)
-    return g_v, g_w
+    p_w = jnp.concatenate([jnp.swapaxes(m.a_rel, 1, 2), angle_rates[:, :, 2:], angle_rates[:, :, :1]], axis=2)
+    return p_v, p_w
 
 
 def _inverse_2x2(a):
@@ -358,12 +357,23 @@ def _kane_solve(m: CarMotion, m_c, f_c, mass, inertia, spin, f_up, t_up, t_wh):
     force and moment and the wheel's moment (4, 3, upright axes; inertial, gravity and
     applied)."""
     n_c = m_c.shape[0]
-    g_v, g_w = _corner_partials(m)
-    g_spin = g_w[:, 1, :].at[:, n_c + 1].add(1.0)  # the wheel's spin rate about the upright's y
-    mass_l = (jnp.einsum("kia,k,kib->kab", g_v, mass, g_v) + jnp.einsum("kia,kij,kjb->kab", g_w, inertia, g_w)
-              + spin[:, None, None] * g_spin[:, :, None] * g_spin[:, None, :])
-    force_l = (jnp.einsum("kia,ki->ka", g_v, f_up) + jnp.einsum("kia,ki->ka", g_w, t_up + t_wh)
-               + jnp.zeros((4, n_c + 2)).at[:, n_c + 1].set(t_wh[:, 1]))
+    p_v, p_w = _corner_partials(m)
+    spin_rate = p_w[:, 1, :]  # the wheel's spin rate about the upright's y: the upright's part of it
+    mass_w = jnp.einsum("kia,kib->kab", p_w, jnp.einsum("kij,kjl->kil", inertia, p_w)) + (
+        spin[:, None, None] * spin_rate[:, :, None] * spin_rate[:, None, :])
+    # columns [u, omega, modal rates, travel rate, spin rate]: P_v covers the first n_c + 1,
+    # P_w and the wheel's spin rate columns 3 to n_c, the spin rate its own
+    turned = slice(3, n_c + 1)
+    mass_l = (jnp.zeros((4, n_c + 2, n_c + 2), m_c.dtype)
+              .at[:, : n_c + 1, : n_c + 1].add(mass[:, None, None] * jnp.einsum("kia,kib->kab", p_v, p_v))
+              .at[:, turned, turned].add(mass_w)
+              .at[:, turned, n_c + 1].set(spin[:, None] * spin_rate)
+              .at[:, n_c + 1, turned].set(spin[:, None] * spin_rate)
+              .at[:, n_c + 1, n_c + 1].set(spin))
+    force_l = (jnp.zeros((4, n_c + 2), m_c.dtype)
+               .at[:, : n_c + 1].add(jnp.einsum("kia,ki->ka", p_v, _mv(m.a_rel, f_up)))
+               .at[:, turned].add(jnp.einsum("kia,ki->ka", p_w, t_up + t_wh))
+               .at[:, n_c + 1].set(t_wh[:, 1]))
     m_cb, inv_bb = mass_l[:, :n_c, n_c:], _inverse_2x2(mass_l[:, n_c:, n_c:])
     x = jnp.einsum("kab,kbc->kac", m_cb, inv_bb)  # (4, n_c, 2)
     schur = m_c + mass_l[:, :n_c, :n_c].sum(0) - jnp.einsum("kac,kbc->ab", x, m_cb)
