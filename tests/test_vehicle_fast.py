@@ -84,7 +84,8 @@ def _compare(car, q, z, aux, t):
     c = sys.body_names.index("chassis")
     wheels = [sys.q_offsets[sys.body_names.index(f"{k}.wheel")] for k in CORNERS]
     expected = jnp.concatenate([y_dot[sys.q_offsets[c] : sys.q_offsets[c + 1]], travel_acc, y_dot[np.asarray(wheels)]])
-    return fast.u_dot, expected, fast.aux_dot, lib.aux_dot, fast.link_residual
+    kinematics = [(k.x, k.xd, k.point_rotations, k.point_omega) for k in (fast.kinematics, lib.kinematics)]
+    return fast.u_dot, expected, fast.aux_dot, lib.aux_dot, fast.link_residual, kinematics
 
 
 @pytest.fixture(scope="module")
@@ -99,7 +100,7 @@ def compared(car):
 
 
 def test_accelerations_equal_the_library_car_at_random_states(compared):
-    fast, lib, aux_fast, aux_lib, residual = compared
+    fast, lib, aux_fast, aux_lib, residual, _ = compared
     scale = jnp.max(jnp.abs(lib), axis=1, keepdims=True)
     assert float(jnp.min(scale)) > 1.0  # the states do accelerate
     assert float(jnp.max(jnp.abs(fast - lib) / scale)) < 1e-6
@@ -107,10 +108,20 @@ def test_accelerations_equal_the_library_car_at_random_states(compared):
     assert float(jnp.max(residual)) < 1e-10
 
 
+def test_point_kinematics_equal_the_library_car_at_random_states(compared):
+    """What the force elements read: every point's position, velocity (the rack's rate
+    included at the rack's points), material orientation and angular velocity equal the
+    library car's."""
+    fast, lib = compared[-1]
+    for name, a, b in zip(("x", "xd", "point_rotations", "point_omega"), fast, lib, strict=True):
+        scale = float(jnp.max(jnp.abs(b)))
+        assert float(jnp.max(jnp.abs(a - b))) < 1e-9 * scale, name
+
+
 def test_rigid_chassis_equals_the_library_car():
     car = load_car(modes=0)
     q, z, aux, t = _random_library_states(car, 8, seed=4)
-    fast, lib, aux_fast, aux_lib, residual = jax.jit(jax.vmap(lambda *a: _compare(car, *a)))(q, z, aux, t)
+    fast, lib, aux_fast, aux_lib, residual, _ = jax.jit(jax.vmap(lambda *a: _compare(car, *a)))(q, z, aux, t)
     assert fast.shape == (8, 14)
     scale = jnp.max(jnp.abs(lib), axis=1, keepdims=True)
     assert float(jnp.max(jnp.abs(fast - lib) / scale)) < 1e-6

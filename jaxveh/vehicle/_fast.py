@@ -270,16 +270,17 @@ def _point_kinematics(car, model, lay, m: CarMotion, q, rack):
     return x, rots, r_up, a_up, a_wh
 
 
-def _point_rates(car, model, lay, m: CarMotion, velocity, a_up, q):
+def _point_rates(car, model, lay, m: CarMotion, velocity, a_up, q, rack, rack_rate):
     """Velocities and angular velocities (global axes) of every point, linear in the body
-    velocities ``velocity`` (plus the rack rate through ``velocity``)."""
+    velocities ``velocity`` and the rack rate (m/s; it moves the rack's points on the
+    chassis)."""
     pt = model.points
-    local, shapes, rshapes, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.upright, pt.wheel
+    local, shapes, rshapes, inputs, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.inputs, pt.upright, pt.wheel
     qc = split(car, q)[0]
     vc, v_up, w_up, w_wheel = velocity
-    x_ch = local + shapes @ qc[6:]
+    x_ch = local + shapes @ qc[6:] + rack * inputs
     uc, wc = lay["upright_corner"], lay["wheel_corner"]
-    xd_ch = _mv(m.a_c[None], vc[None, :3] + jnp.cross(vc[None, 3:6], x_ch) + shapes @ vc[6:])
+    xd_ch = _mv(m.a_c[None], vc[None, :3] + jnp.cross(vc[None, 3:6], x_ch) + shapes @ vc[6:] + rack_rate * inputs)
     xd_up = _mv(a_up[uc], v_up[uc] + jnp.cross(w_up[uc], up))
     # wheel points (the hubs) sit on the spin axis: their velocity is the upright's there
     xd_wh = _mv(a_up[wc], v_up[wc] + jnp.cross(w_wheel[wc], _mv(m.spin_rot[wc], wh)))
@@ -444,7 +445,7 @@ def fast_dynamics(car: Car, model: FastModel, q, u, aux, t, inputs, elements) ->
     # the rack acceleration needs aux_dot, which needs the kinematics: motion at zero first
     m = car_motion(car, model, q, u, rack, rack_rate, jnp.zeros_like(rack))
     x, rots, r_up, a_up, a_wh = _point_kinematics(car, model, lay, m, q, rack)
-    xd, om = _point_rates(car, model, lay, m, m.velocity, a_up, q)
+    xd, om = _point_rates(car, model, lay, m, m.velocity, a_up, q, rack, rack_rate)
     origins, rotations = _body_frames(car, lay, m, r_up, a_up, a_wh)
     kin = Kinematics(t=t, q=q, v=u, u=rack_v, u_dot=rack_dot_v, origins=origins, rotations=rotations, x=x, xd=xd,
                      point_rotations=rots, point_omega=om, modal=_modal_values(car, q))
