@@ -248,13 +248,19 @@ def _point_tables(car: Car, params: SystemParams, lay) -> PointTables:
                        upright=up, wheel=wh)
 
 
+def _chassis_points(car, model, q, rack):
+    """Positions (m, chassis axes) of the chassis's points: design, modal deflection and the
+    rack's travel (at the rack's points)."""
+    pt = model.points
+    return pt.chassis + pt.shapes @ split(car, q)[0][6:] + rack * pt.inputs
+
+
 def _point_kinematics(car, model, lay, m: CarMotion, q, rack):
     """Positions and material orientations of every point (library order)."""
-    qc = split(car, q)[0]
     pt = model.points
-    local, shapes, rshapes, inputs, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.inputs, pt.upright, pt.wheel
-    modes = qc[6:]
-    x_ch = local + shapes @ modes + rack * inputs
+    rshapes, up, wh = pt.rotation_shapes, pt.upright, pt.wheel
+    modes = split(car, q)[0][6:]
+    x_ch = _chassis_points(car, model, q, rack)
     a_up = _mm(m.a_c[None], m.a_rel)
     r_up = m.r_c[None, :] + _mv(m.a_c[None], m.r_rel)
     a_wh = _mm(a_up, m.spin_rot)
@@ -275,10 +281,9 @@ def _point_rates(car, model, lay, m: CarMotion, velocity, a_up, q, rack, rack_ra
     velocities ``velocity`` and the rack rate (m/s; it moves the rack's points on the
     chassis)."""
     pt = model.points
-    local, shapes, rshapes, inputs, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.inputs, pt.upright, pt.wheel
-    qc = split(car, q)[0]
+    shapes, rshapes, inputs, up, wh = pt.shapes, pt.rotation_shapes, pt.inputs, pt.upright, pt.wheel
     vc, v_up, w_up, w_wheel = velocity
-    x_ch = local + shapes @ qc[6:] + rack * inputs
+    x_ch = _chassis_points(car, model, q, rack)
     uc, wc = lay["upright_corner"], lay["wheel_corner"]
     xd_ch = _mv(m.a_c[None], vc[None, :3] + jnp.cross(vc[None, 3:6], x_ch) + shapes @ vc[6:] + rack_rate * inputs)
     xd_up = _mv(a_up[uc], v_up[uc] + jnp.cross(w_up[uc], up))
@@ -304,9 +309,9 @@ def _applied_wrenches(car, model, lay, m: CarMotion, a_up, q, rack, forces, torq
     moment about its centre and the wheel's moment about its hub (upright axes; the wheel's
     force is the upright's). The point-velocity Jacobian transposed, body by body."""
     pt = model.points
-    local, shapes, rshapes, inputs, up, wh = pt.chassis, pt.shapes, pt.rotation_shapes, pt.inputs, pt.upright, pt.wheel
+    shapes, rshapes, up, wh = pt.shapes, pt.rotation_shapes, pt.upright, pt.wheel
     ch = lay["chassis_points"]
-    x_ch = local + shapes @ q[6:6 + car.n_modes] + rack * inputs
+    x_ch = _chassis_points(car, model, q, rack)
     f_ch, t_ch = _mv(m.a_c.T[None], forces[ch]), _mv(m.a_c.T[None], torques[ch])
     modal = jnp.einsum("pim,pi->m", shapes, f_ch) + jnp.einsum("pim,pi->m", rshapes, t_ch)
     q_chassis = jnp.concatenate([f_ch.sum(0), (jnp.cross(x_ch, f_ch) + t_ch).sum(0), modal])
@@ -359,17 +364,18 @@ def _kane_solve(m: CarMotion, m_c, f_c, mass, inertia, spin, f_up, t_up, t_wh):
     applied)."""
     n_c = m_c.shape[0]
     p_v, p_w = _corner_partials(m)
-    spin_rate = p_w[:, 1, :]  # the wheel's spin rate about the upright's y: the upright's part of it
+    # the wheel's angular velocity about the upright's y: the upright's (these columns) + its spin rate
+    spin_partial = p_w[:, 1, :]
     mass_w = jnp.einsum("kia,kib->kab", p_w, jnp.einsum("kij,kjl->kil", inertia, p_w)) + (
-        spin[:, None, None] * spin_rate[:, :, None] * spin_rate[:, None, :])
+        spin[:, None, None] * spin_partial[:, :, None] * spin_partial[:, None, :])
     # columns [u, omega, modal rates, travel rate, spin rate]: P_v covers the first n_c + 1,
     # P_w and the wheel's spin rate columns 3 to n_c, the spin rate its own
     turned = slice(3, n_c + 1)
     mass_l = (jnp.zeros((4, n_c + 2, n_c + 2), m_c.dtype)
               .at[:, : n_c + 1, : n_c + 1].add(mass[:, None, None] * jnp.einsum("kia,kib->kab", p_v, p_v))
               .at[:, turned, turned].add(mass_w)
-              .at[:, turned, n_c + 1].set(spin[:, None] * spin_rate)
-              .at[:, n_c + 1, turned].set(spin[:, None] * spin_rate)
+              .at[:, turned, n_c + 1].set(spin[:, None] * spin_partial)
+              .at[:, n_c + 1, turned].set(spin[:, None] * spin_partial)
               .at[:, n_c + 1, n_c + 1].set(spin))
     force_l = (jnp.zeros((4, n_c + 2), m_c.dtype)
                .at[:, : n_c + 1].add(jnp.einsum("kia,ki->ka", p_v, _mv(m.a_rel, f_up)))
