@@ -3,9 +3,13 @@ step steer at 90 km/h, in the fast form (minimal coordinates) against the librar
 the CommonRoad multi-body model, with ``simulate``'s default solver at rtol 1e-4 (KenCarp5
 IMEX on the fast car, Tsit5 on the library car; ``--solver`` to choose).
 
-Measures, through the public ``jaxveh.manoeuvre`` API: compile time (the straight-running
-trim plus the run), the run's wall time after compilation (best of three; the trim is
-timed beside it), steps, batches of step steers of different amplitude under ``jax.vmap``
+Measures, through the public ``jaxveh.manoeuvre`` API: compile time (``compile_s``: what the
+first ``simulate`` of the step steer in a fresh process waits for beyond a later call's
+time, i.e. tracing and compiling its programs, the straight-running trim's and the run's,
+which ``simulate`` compiles at once on two threads; no disk cache; ``details.trim_compile_s``
+and ``run_compile_s``: the same two programs with their run-time checks, one after the
+other, as a user's own ``jit`` compiles them), the run's wall time after compilation (best
+of three; the trim is timed beside it), steps, batches of step steers of different amplitude under ``jax.vmap``
 (sims/s on the machine's cores: ``jaxveh.map_on_cores``, one vmapped call per core on its
 part of the batch; ``batch_sims_per_s_one_call`` the same batches as one call),
 ``jax.grad`` of the yaw-rate overshoot w.r.t. every leaf of ``CarParams`` over
@@ -180,9 +184,27 @@ def long_runs(car) -> dict:
     return out
 
 
+def first_simulate(car, solver: str) -> dict:
+    """The first ``simulate`` of the step steer in this process (trace, compile and run of its
+    programs) against the best of two later calls: ``compile_s`` is the difference. Run
+    first, before any other program of the car is traced (JAX's in-memory caches), and
+    refused with a disk cache (it would skip XLA's compilation)."""
+    if jax.config.jax_compilation_cache_dir:
+        raise RuntimeError("bench_car measures compilation: unset JAX's persistent compilation cache "
+                           f"({jax.config.jax_compilation_cache_dir})")
+    m = step_steer(speed=SPEED, angle=ANGLE, start=START, rise=RISE, duration=DURATION)
+    first = _timed(lambda: simulate(car, m, points=POINTS, rtol=RTOL, solver=solver))[1]
+    again = _best(lambda: simulate(car, m, points=POINTS, rtol=RTOL, solver=solver), repeats=2)
+    return {"compile_s": first - again, "simulate_first_call_s": first, "simulate_again_s": again}
+
+
 def bench(quick: bool, solver: str, log) -> dict:
     car = load_car(modes=6)
     res: dict = {"solver": pick_solver(solver, "fast", RTOL)}
+    res |= first_simulate(car, res["solver"])
+    log(f"first simulate {res['simulate_first_call_s']:.1f} s, then {res['simulate_again_s']:.2f} s: "
+        f"compile {res['compile_s']:.1f} s")
+    free_compiled()
     trim_fn = eqx.filter_jit(straight_trim)
     trim, res["trim_compile_s"] = _timed(trim_fn, car, SPEED, "fast")
     res["trim_s"] = _best(trim_fn, car, SPEED, "fast")
@@ -192,7 +214,6 @@ def bench(quick: bool, solver: str, log) -> dict:
     if int(status) != 0:
         raise RuntimeError(f"the benchmark step steer did not complete (status {int(status)})")
     res["run_compile_s"] = first
-    res["compile_s"] = res["trim_compile_s"] + first
     res["wall_s"] = _best(fast, car, trim, ANGLE, rtol)
     res["steps"] = int(stats["num_steps"])
     res["rejected_steps"] = int(stats["num_rejected_steps"])
@@ -200,7 +221,8 @@ def bench(quick: bool, solver: str, log) -> dict:
     res["response"] = {"final_yaw_rate_deg_s": float(r[-1]), "final_ay_g": float(ch["ay"][-1]),
                        "yaw_rate_overshoot": float((r.max() - r[-1]) / r[-1]),
                        "front_road_wheel_angle_deg": float(np.mean(np.asarray(ch["road_wheel_angle"])[-1, :2]))}
-    log(f"fast car: compile {res['compile_s']:.0f} s (trim {res['trim_compile_s']:.0f} s), run {res['wall_s']:.2f} s, "
+    log(f"fast car: trim and run compiled one after the other, with run-time checks: {res['trim_compile_s']:.0f} + "
+        f"{res['run_compile_s']:.0f} s; run {res['wall_s']:.2f} s, "
         f"{res['steps']} steps ({res['rejected_steps']} rejected), trim {res['trim_s']:.2f} s")
 
     library = runner("library", pick_solver(solver, "library", RTOL))
@@ -304,7 +326,7 @@ def main():
         return
     peer = res["peer_wall_s"]
     rows = [
-        ("compile (trim + run)", f"{res['compile_s']:.0f} s", "<= 30 s"),
+        ("compile (first simulate)", f"{res['compile_s']:.0f} s", "<= 30 s"),
         ("5 s step steer, fast car", f"{res['wall_s']:.2f} s, {res['steps']} steps", "<= 0.1 s, <= peer / 2"),
         ("trim (straight running)", f"{res['trim_s']:.2f} s", ""),
         ("library car, same tolerance", f"{res['library_wall_s']:.2f} s", ""),

@@ -264,6 +264,54 @@ def test_a_given_trim_is_where_the_run_starts():
         simulate(car, m, form="library", trim=start_trim(car, m.speed))
 
 
+class _Compiles:
+    """The programs XLA compiles while in the ``with`` block, by name (JAX's monitoring
+    events; each in-memory cache miss is one, the disk cache's hits included)."""
+
+    def __enter__(self):
+        self.names = []
+        jax.monitoring.register_event_duration_secs_listener(self._record)
+        return self
+
+    def _record(self, event, duration, **kwargs):
+        if event == "/jax/core/compile/backend_compile_duration":
+            self.names.append(kwargs.get("fun_name", ""))
+
+    def __exit__(self, *exc):
+        jax.monitoring.unregister_event_duration_listener(self._record)
+
+    def count(self, name):
+        return sum(name in n for n in self.names)
+
+
+#: :func:`simulate`'s programs on the fast car (compiled at once on two threads).
+FAST_PROGRAMS = ("straight_trim_core", "_fast_solve_program", "_fast_channels_program")
+
+
+def test_first_simulate_compiles_each_program_once(runs):
+    """The first ``simulate`` of a new signature (11 save times) compiles the solve and the
+    channels once each (and the trim, unless compiled before), for placeholders of their
+    inputs, and the calls then find them compiled; a second call compiles none. The run saves the fixture's rigid run at
+    every 50th of its save times (save times never force steps): the same values to the
+    integration's tolerance (rtol 1e-8; the programs differ, so may their round-off and
+    the adaptive steps)."""
+    car, m = load_car(modes=0), step_steer(angle=ANGLE)
+    with _Compiles() as first:
+        run = simulate(car, m, rtol=TIGHT, points=11)
+    with _Compiles() as again:
+        simulate(car, m, rtol=TIGHT, points=11)
+    assert first.count("straight_trim_core") <= 1  # the fixture's serves when compiled there
+    for name in FAST_PROGRAMS[1:]:
+        assert first.count(name) == 1, (name, first.names)
+    assert not any(again.count(name) for name in FAST_PROGRAMS), again.names
+    reference = {k: v[::50] for k, v in _channels(runs[0, "fast"]).items()}
+    for name, value in _channels(run).items():
+        assert value.shape == reference[name].shape, name
+        if value.size:  # the rigid car has no modal coordinates
+            scale = max(np.max(np.abs(reference[k])) for k in SHARED_SCALE.get(name, (name,)))
+            assert np.max(np.abs(value - reference[name])) <= 1e-6 * scale, name
+
+
 #: Channels that change sign in the mirror image of a run (the rest keep it).
 ODD_CHANNELS = ("steering_wheel_angle", "y", "heading", "ay", "yaw_rate", "sideslip", "roll", "twist", "fy",
                 "slip_angle", "camber", "road_wheel_angle")

@@ -12,6 +12,7 @@ reason.
 
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 
 import diffrax
 import equinox as eqx
@@ -163,29 +164,39 @@ def _explicit_states(car) -> tuple[int, ...]:
     return GROUND_POSE + tuple(range(spins, spins + 4))
 
 
-def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint, linearisations):
-    del freeze_steps  # refused for the fast car, which has no projection
-    driving = _driving(car, manoeuvre, trim.rack, 0)
-    law, elements = driving.law, driving.elements
-    s0 = FastState(trim.state.q, trim.state.u, jnp.concatenate([trim.state.aux, driving.aux0]))
-    model = fast_model(car)
+class _FastSolve(eqx.Module):
+    """The fast car's solve of a manoeuvre: the ``states`` at the save times (held at the last
+    reached one after a stop), the ``model`` it ran (:func:`fast_model`), Diffrax's ``stats``
+    (with ``event`` and ``valid``) and the ``status``."""
 
-    # jitted so that one trace serves the stage loop, the split's Jacobian and the channels
-    # (JAX's trace cache): the car's equations were traced seven times, half the tracing time
-    dynamics = jax.jit(lambda t, s: fast_dynamics(car, model, s.q, s.u, s.aux, t, law, elements))
+    states: FastState
+    model: object
+    stats: dict
+    status: Array
+
+
+def _fast_setup(car, manoeuvre, trim, model):
+    """The manoeuvre's :class:`_Driving` on the fast car and its equations
+    ``dynamics(t, state)``, jitted so that one trace serves the stage loop, the split's
+    Jacobian and the channels of one program (JAX's trace cache: the car's equations were
+    traced seven times, half the tracing time)."""
+    driving = _driving(car, manoeuvre, trim.rack, 0)
+    return driving, jax.jit(lambda t, s: fast_dynamics(car, model, s.q, s.u, s.aux, t, driving.law,
+                                                       driving.elements))
+
+
+def _fast_solve(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, adjoint, linearisations, model,
+                driving, dynamics) -> _FastSolve:
+    s0 = FastState(trim.state.q, trim.state.u, jnp.concatenate([trim.state.aux, driving.aux0]))
 
     def field(t, s, args):
         d = dynamics(t, s)
         return FastState(d.q_dot, d.u_dot, d.aux_dot)
 
-    def channels(t, s):
-        d = dynamics(t, s)
-        out = car_channels(car, elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], driving.angle(t, s.aux))
-        return out | {"constraint_residual": d.link_residual}
-
     conditions = tuple(lambda t, s, args, fn=fn, **kw: fn(s.q, s.u) for fn in (_rolled_over, _spun))
-    # the states at the save times (dense output), then the channels in one vectorised pass:
-    # a save function would be traced five times by Diffrax and sit inside the step loop
+    # the states at the save times (dense output); the channels follow in one vectorised
+    # pass (_fast_channels): a save function would be traced five times by Diffrax and sit
+    # inside the step loop
     sol = relinearised_solve(
         field, s0, manoeuvre.duration, ts, segments=linearisations if solver in IMEX_SOLVERS else 1,
         controller=diffrax.PIDController(rtol=rtol, atol=atol, jump_ts=kink_times(manoeuvre)),
@@ -195,8 +206,43 @@ def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps,
     valid = jnp.isfinite(sol.ys.q[:, 0])  # Diffrax fills the save times after a stop with inf
     states = jax.tree.map(lambda x: _hold_after_stop(x, valid), sol.ys)
     stats = dict(sol.stats) | {"event": _event_code(rolled, spun), "valid": valid}
-    status = sol.status
-    return jax.vmap(channels)(ts, states), stats, status
+    return _FastSolve(states=states, model=model, stats=stats, status=sol.status)
+
+
+def _fast_channels(car, ts, states, driving, dynamics) -> dict:
+    """The channels at the save times ``ts`` from the ``states`` there, in one vectorised
+    pass."""
+
+    def channels(t, s):
+        d = dynamics(t, s)
+        out = car_channels(car, driving.elements, d.kinematics, s.aux, s.u[:6], d.u_dot[:6], driving.angle(t, s.aux))
+        return out | {"constraint_residual": d.link_residual}
+
+    return jax.vmap(channels)(ts, states)
+
+
+def _fast(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, freeze_steps, adjoint, linearisations):
+    del freeze_steps  # refused for the fast car, which has no projection
+    model = fast_model(car)
+    driving, dynamics = _fast_setup(car, manoeuvre, trim, model)
+    sol = _fast_solve(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, adjoint, linearisations, model,
+                      driving, dynamics)
+    return _fast_channels(car, ts, sol.states, driving, dynamics), sol.stats, sol.status
+
+
+def _fast_solve_program(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, linearisations) -> _FastSolve:
+    """:func:`simulate`'s first program on the fast car: the solve (the channels are a second
+    program, compiled beside it, :func:`_compile_programs`)."""
+    model = fast_model(car)
+    driving, dynamics = _fast_setup(car, manoeuvre, trim, model)
+    return _fast_solve(car, manoeuvre, trim, ts, solver, rtol, atol, max_steps, None, linearisations, model,
+                       driving, dynamics)
+
+
+def _fast_channels_program(car, manoeuvre, trim, ts, states, model) -> dict:
+    """:func:`simulate`'s second program on the fast car: the channels of a solve's states."""
+    driving, dynamics = _fast_setup(car, manoeuvre, trim, model)
+    return _fast_channels(car, ts, states, driving, dynamics)
 
 
 def _rolled_over(q, u):
@@ -309,15 +355,83 @@ _compiled_fast_trim = eqx.filter_jit(straight_trim_core)
 _compiled = eqx.filter_jit(manoeuvre_channels)
 
 
+def _trim_program(form: str):
+    return _compiled_fast_trim if form == "fast" else _compiled_library_trim
+
+
+def _trim_ok(trim, form: str):
+    return trim.ok if form == "fast" else trim.static.ok
+
+
 def _compiled_trim(car, speed, form):
     """``(trim, ok)``: :func:`straight_trim` compiled and whether its Newton solve
     converged."""
-    speed = jnp.asarray(speed, jnp.float64)
-    if form == "fast":
-        trim = _compiled_fast_trim(car, speed)
-        return trim, trim.ok
-    trim = _compiled_library_trim(car, speed)
-    return trim, trim.static.ok
+    trim = _trim_program(form)(car, jnp.asarray(speed, jnp.float64))
+    return trim, _trim_ok(trim, form)
+
+
+_compiled_fast_solve = eqx.filter_jit(_fast_solve_program)
+_compiled_fast_channels = eqx.filter_jit(_fast_channels_program)
+#: Signatures of the program sets :func:`_compile_programs` has compiled.
+_compiled_sets: set = set()
+
+
+def _signature(*trees):
+    """A hashable key of what a compiled program depends on in ``trees``: their structure,
+    the shapes and dtypes of their arrays and their other leaves (None if one is
+    unhashable)."""
+    leaves, treedef = jax.tree.flatten(trees)
+    key = (treedef, tuple((x.shape, x.dtype) if eqx.is_array(x) else x for x in leaves))
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key
+
+
+def _placeholder(shapes):
+    """Zeros of the shapes and dtypes of ``eqx.filter_eval_shape``'s output (other leaves as they
+    are): what a program is compiled for before the values exist."""
+    return jax.tree.map(lambda s: jnp.zeros(s.shape, s.dtype) if isinstance(s, jax.ShapeDtypeStruct) else s, shapes)
+
+
+def _run_programs(car, manoeuvre, ts, trim, run_kwargs: dict):
+    """``(channels, stats, status)`` of :func:`simulate`'s compiled programs from ``trim``: on
+    the fast car the solve and then the channels of its states (two programs, so that they
+    compile at once), on the library car one program."""
+    if run_kwargs["form"] == "library":
+        return _compiled(car, manoeuvre, ts, trim=trim, **run_kwargs)
+    kwargs = {k: run_kwargs[k] for k in ("solver", "rtol", "atol", "max_steps", "linearisations")}
+    sol = _compiled_fast_solve(car, manoeuvre, trim, ts, **kwargs)
+    return _compiled_fast_channels(car, manoeuvre, trim, ts, sol.states, sol.model), sol.stats, sol.status
+
+
+def _compile_programs(car, speed, manoeuvre, ts, run_kwargs: dict) -> None:
+    """Compile :func:`simulate`'s programs (the trim's, and the run's: on the fast car the
+    solve's and the channels') at once, once per signature: this thread traces each in turn
+    for placeholders of its inputs' shapes (``eqx.filter_eval_shape`` of the program before it)
+    and two more compile them as they come (XLA releases the Python lock while it compiles,
+    so they use two cores). JAX's cache then serves the calls (docs/manoeuvre.md,
+    "Compilation")."""
+    key = _signature(car, manoeuvre, ts, run_kwargs)
+    if key is None or key in _compiled_sets:
+        return
+    form = run_kwargs["form"]
+    trim_program, speed = _trim_program(form), jnp.asarray(speed, jnp.float64)
+    with ThreadPoolExecutor(2) as pool:
+        trim = _placeholder(eqx.filter_eval_shape(trim_program, car, speed))
+        jobs = [pool.submit(trim_program.lower(car, speed).compile)]
+        if form == "library":
+            jobs.append(pool.submit(_compiled.lower(car, manoeuvre, ts, trim=trim, **run_kwargs).compile))
+        else:
+            kwargs = {k: run_kwargs[k] for k in ("solver", "rtol", "atol", "max_steps", "linearisations")}
+            sol = _placeholder(eqx.filter_eval_shape(_compiled_fast_solve, car, manoeuvre, trim, ts, **kwargs))
+            jobs.append(pool.submit(_compiled_fast_solve.lower(car, manoeuvre, trim, ts, **kwargs).compile))
+            jobs.append(pool.submit(_compiled_fast_channels.lower(car, manoeuvre, trim, ts, sol.states,
+                                                                  sol.model).compile))
+        for job in jobs:
+            job.result()
+    _compiled_sets.add(key)
 
 
 def start_trim(car, speed, form: str | None = None):
@@ -381,19 +495,19 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     ts = save_times(manoeuvre, points)
     check_car(car)  # here, so that the programs need no run-time checks (the disk cache keeps them)
     start = time.perf_counter()
+    run_kwargs = dict(form=form, solver=solver, rtol=jnp.asarray(rtol, jnp.float64),
+                      atol=jnp.asarray(atol, jnp.float64), max_steps=max_steps, freeze_steps=freeze_steps,
+                      linearisations=linearisations)  # tolerances as arrays: one compilation serves all
     with run_time_checks_off():
         if trim is None:
+            _compile_programs(car, manoeuvre.speed, manoeuvre, ts, run_kwargs)
             trim, trim_ok = _compiled_trim(car, manoeuvre.speed, form)
         else:
             trim_ok = _check_trim(trim, form)
         if not bool(trim_ok):
             raise SetupError(f"the {form} car's straight running at {float(manoeuvre.speed):g} m/s was not found "
                              "(the powertrain's torque against drag and rolling resistance?)")
-        # tolerances as arrays: one compilation serves every tolerance
-        channels, stats, status = _compiled(car, manoeuvre, ts, form=form, trim=trim, solver=solver,
-                                            rtol=jnp.asarray(rtol, jnp.float64), atol=jnp.asarray(atol, jnp.float64),
-                                            max_steps=max_steps, freeze_steps=freeze_steps,
-                                            linearisations=linearisations)
+        channels, stats, status = _run_programs(car, manoeuvre, ts, trim, run_kwargs)
         channels = jax.block_until_ready(channels)
     wall = time.perf_counter() - start
     status, valid = int(status), np.asarray(stats["valid"])
