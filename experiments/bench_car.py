@@ -10,8 +10,9 @@ which ``simulate`` compiles at once on two threads; no disk cache; ``details.tri
 and ``run_compile_s``: the same two programs with their run-time checks, one after the
 other, as a user's own ``jit`` compiles them), the run's wall time after compilation (best
 of three; the trim is timed beside it), steps, batches of step steers of different amplitude under ``jax.vmap``
-(sims/s on the machine's cores: ``jaxveh.map_on_cores``, one vmapped call per core on its
-part of the batch; ``batch_sims_per_s_one_call`` the same batches as one call),
+(sims/s on the machine's cores: ``jaxveh.map_on_cores``, vmapped calls on parts of at
+most :data:`BATCH_PART` from one thread per core; ``batch_sims_per_s_one_call`` the same
+batches as one call),
 ``jax.grad`` of the yaw-rate overshoot w.r.t. every leaf of ``CarParams`` over
 the same function's forward time, the worst channel's difference from the library car
 (both at rtol 1e-8), the library car's wall time at the fast run's tolerance, Table 7.2's
@@ -64,6 +65,10 @@ SETTLE = 0.5  # s: the steady yaw rate is the mean over the run's last SETTLE
 REFERENCE_RTOL = 1e-8
 POINTS = 501
 BATCHES = (1, 16, 64, 256)
+#: The most step steers one vmapped call takes on a core (``map_on_cores``' ``part_size``): a
+#: batch of 256 ran 53.8 sims/s in parts of 32 against 37.6 in two parts of 128, and 52.6 in
+#: parts of 16 (docs/manoeuvre.md, "Speed", twenty-fifth measurement).
+BATCH_PART = 32
 #: Channels compared with the library car (the constraint residual differs by definition).
 COMPARED = ("speed", "ax", "ay", "yaw_rate", "sideslip", "roll", "pitch", "twist", "modes", "fz", "fx", "fy",
             "slip_angle", "slip_ratio", "camber", "travel", "road_wheel_angle", "spring_length", "spring_force")
@@ -242,7 +247,7 @@ def bench(quick: bool, solver: str, log) -> dict:
 
     free_compiled()
     res["batch_sims_per_s"], res["batch_sims_per_s_one_call"], res["batch_compile_s"] = {}, {}, {}
-    res["cores"] = jaxveh.core_count()
+    res["cores"], res["batch_part_size"] = jaxveh.core_count(), BATCH_PART
     batched = eqx.filter_jit(jax.vmap(lambda car, trim, angle, rtol: fast(car, trim, angle, rtol)[0]["yaw_rate"],
                                       in_axes=(None, None, 0, None)))
 
@@ -250,7 +255,7 @@ def bench(quick: bool, solver: str, log) -> dict:
         return batched(car, trim, angles, rtol)
 
     def on_cores(angles):
-        return jaxveh.map_on_cores(part, angles)
+        return jaxveh.map_on_cores(part, angles, part_size=BATCH_PART)
 
     for n in BATCHES[:2] if quick else BATCHES:
         angles = jnp.linspace(0.5, 1.0, n) * ANGLE

@@ -27,6 +27,28 @@ def test_parts_equal_one_call(n, cores):
     np.testing.assert_array_equal(parts["x"], np.asarray(whole["x"]))
 
 
+@pytest.mark.parametrize("n, cores, part_size, calls", [(10, 2, 3, 4), (10, 2, 5, 2), (10, 2, 20, 2), (9, 3, 2, 5),
+                                                        (4, 1, 1, 4)])
+def test_parts_of_a_given_size_equal_one_call(n, cores, part_size, calls):
+    """With ``part_size`` the batch is cut into ``ceil(n / part_size)`` parts (at least one per
+    core), each of one size (compiled once), and the cores take them in turn."""
+    rng = np.random.default_rng(n)
+    batch = {"x": rng.normal(size=(n, 3)), "scale": rng.normal(size=n)}
+    whole = jax.jit(_field)(batch)
+    sizes = []
+
+    def counted(b):
+        sizes.append(b["x"].shape[0])
+        return _field(b)
+
+    fn = jax.jit(counted)
+    called = []
+    parts = map_on_cores(lambda b: called.append(1) or fn(b), batch, cores=cores, part_size=part_size)
+    assert len(called) == calls and len(sizes) == 1 and sizes[0] == -(-n // calls)
+    np.testing.assert_array_equal(parts["sum"], np.asarray(whole["sum"]))
+    np.testing.assert_array_equal(parts["x"], np.asarray(whole["x"]))
+
+
 def test_compiles_once_per_part_size():
     traces = []
 
@@ -49,6 +71,8 @@ def test_bad_batches_are_refused():
         map_on_cores(fn, {"a": np.zeros(3), "b": 1.0})
     with pytest.raises(ParameterError, match="cores must be an int >= 1"):
         map_on_cores(fn, np.zeros(3), cores=0)
+    with pytest.raises(ParameterError, match="part_size must be None or an int >= 1"):
+        map_on_cores(fn, np.zeros(3), part_size=0)
     with pytest.raises(ParameterError, match="empty"):
         map_on_cores(fn, np.zeros((0, 2)))
     assert jaxveh.core_count() >= 1
