@@ -10,9 +10,9 @@ which ``simulate`` compiles at once on two threads; no disk cache; ``details.tri
 and ``run_compile_s``: the same two programs with their run-time checks, one after the
 other, as a user's own ``jit`` compiles them), the run's wall time after compilation (best
 of three; the trim is timed beside it), steps, batches of step steers of different amplitude under ``jax.vmap``
-(sims/s on the machine's cores: ``jaxveh.map_on_cores``, vmapped calls on parts of at
-most :data:`BATCH_PART` from one thread per core; ``batch_sims_per_s_one_call`` the same
-batches as one call),
+(sims/s on the machine's cores, best of two: ``jaxveh.map_on_cores``, vmapped calls on
+parts of at most :data:`BATCH_PART` from one thread per core; ``batch_sims_per_s_one_call``
+the same batches as one call),
 ``jax.grad`` of the yaw-rate overshoot w.r.t. every leaf of ``CarParams`` over
 the same function's forward time, the worst channel's difference from the library car
 (both at rtol 1e-8), the library car's wall time at the fast run's tolerance, Table 7.2's
@@ -263,7 +263,7 @@ def bench(quick: bool, solver: str, log) -> dict:
         wall = _best(batched, car, trim, angles, rtol, repeats=2 if n <= 16 else 1)
         res["batch_sims_per_s_one_call"][str(n)] = n / wall
         on_cores(angles)  # the parts' size compiled
-        wall = _best(on_cores, angles, repeats=2 if n <= 16 else 1)
+        wall = _best(on_cores, angles, repeats=2)
         res["batch_sims_per_s"][str(n)] = n / wall
         log(f"batch {n}: {n / wall:.2f} sims/s on {res['cores']} cores "
             f"({res['batch_sims_per_s_one_call'][str(n)]:.2f} as one call)")
