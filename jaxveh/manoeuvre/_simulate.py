@@ -395,14 +395,18 @@ def _placeholder(shapes):
     return jax.tree.map(lambda s: jnp.zeros(s.shape, s.dtype) if isinstance(s, jax.ShapeDtypeStruct) else s, shapes)
 
 
+def _solve_kwargs(run_kwargs: dict) -> dict:
+    """The options of :func:`_fast_solve_program` among :func:`simulate`'s run options."""
+    return {k: run_kwargs[k] for k in ("solver", "rtol", "atol", "max_steps", "linearisations")}
+
+
 def _run_programs(car, manoeuvre, ts, trim, run_kwargs: dict):
     """``(channels, stats, status)`` of :func:`simulate`'s compiled programs from ``trim``: on
     the fast car the solve and then the channels of its states (two programs, so that they
     compile at once), on the library car one program."""
     if run_kwargs["form"] == "library":
         return _compiled(car, manoeuvre, ts, trim=trim, **run_kwargs)
-    kwargs = {k: run_kwargs[k] for k in ("solver", "rtol", "atol", "max_steps", "linearisations")}
-    sol = _compiled_fast_solve(car, manoeuvre, trim, ts, **kwargs)
+    sol = _compiled_fast_solve(car, manoeuvre, trim, ts, **_solve_kwargs(run_kwargs))
     return _compiled_fast_channels(car, manoeuvre, trim, ts, sol.states, sol.model), sol.stats, sol.status
 
 
@@ -424,7 +428,7 @@ def _compile_programs(car, speed, manoeuvre, ts, run_kwargs: dict) -> None:
         if form == "library":
             jobs.append(pool.submit(_compiled.lower(car, manoeuvre, ts, trim=trim, **run_kwargs).compile))
         else:
-            kwargs = {k: run_kwargs[k] for k in ("solver", "rtol", "atol", "max_steps", "linearisations")}
+            kwargs = _solve_kwargs(run_kwargs)
             sol = _placeholder(eqx.filter_eval_shape(_compiled_fast_solve, car, manoeuvre, trim, ts, **kwargs))
             jobs.append(pool.submit(_compiled_fast_solve.lower(car, manoeuvre, trim, ts, **kwargs).compile))
             jobs.append(pool.submit(_compiled_fast_channels.lower(car, manoeuvre, trim, ts, sol.states,
