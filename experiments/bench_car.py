@@ -9,8 +9,8 @@ time, i.e. tracing and compiling its programs, the straight-running trim's and t
 which ``simulate`` compiles at once on two threads; no disk cache; ``details.trim_compile_s``
 and ``run_compile_s``: the same two programs with their run-time checks, one after the
 other, as a user's own ``jit`` compiles them), the run's wall time after compilation (best
-of three; the trim is timed beside it), steps, batches of step steers of different amplitude under ``jax.vmap``
-(sims/s on the machine's cores, best of two: ``jaxveh.map_on_cores``, vmapped calls on
+of three; the trim is timed beside it), steps, batches of step steers of different
+amplitude under ``jax.vmap`` (sims/s on the machine's cores, best of two: ``jaxveh.map_on_cores``, vmapped calls on
 parts of at most :data:`BATCH_PART` from one thread per core; ``batch_sims_per_s_one_call``
 the same batches as one call),
 ``jax.grad`` of the yaw-rate overshoot w.r.t. every leaf of ``CarParams`` over
