@@ -36,6 +36,7 @@ CAR_FILE_KEYS = {
     "pid.tau": ("powertrain", "tau", "s"),
     "pid.t_min": ("powertrain", "torque_min", "Nm"),
     "pid.t_max": ("powertrain", "torque_max", "Nm"),
+    "pid.brake_front_share": ("powertrain", "brake_front_share", "-"),
 }
 #: Significant digits written (the file is read back to this precision).
 DIGITS = 15

@@ -279,6 +279,70 @@ def four_post(
     _run("four-post", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, points, figures, param)
 
 
+def _straight_line(name: str, speed_kmh, final_speed_kmh, rate_g, duration, vehicle, modes, rigid, form, rtol,
+                   out_dir, as_json, quiet, param):
+    """Acceleration or braking from --speed-kmh to --final-speed-kmh at ``rate_g``."""
+    from ..manoeuvre import accelerate, brake, straight_line_metrics
+
+    flag = "--accel-g" if name == "accelerate" else "--decel-g"
+    if not rate_g > 0.0:
+        fail(f"{flag} must be > 0 g, got {rate_g:g}")
+    if not final_speed_kmh > 0.0:
+        fail(f"--final-speed-kmh must be > 0 (the tyre model needs rolling wheels), got {final_speed_kmh:g}")
+    try:
+        make = accelerate if name == "accelerate" else brake
+        m = make(_speed(speed_kmh), final_speed_kmh / 3.6, rate_g, duration=duration)
+    except ParameterError as e:
+        fail(str(e))
+
+    def metrics(run, car):
+        out = {"final_speed_kmh": final_speed_kmh}
+        try:
+            return out | straight_line_metrics(run.ts, run.channels, m.speed_target)
+        except ParameterError as e:
+            return out | {"metrics_error": str(e)}
+
+    _run(name, m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, settings=param)
+
+
+DurationAutoOpt = typer.Option(None, "--duration", help="s (default: the speed change and 1 s after)")
+
+
+@app.command("accelerate")
+def accelerate(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    speed_kmh: float = typer.Option(30.0, "--speed-kmh", help="start speed, km/h"),
+    final_speed_kmh: float = typer.Option(90.0, "--final-speed-kmh", help="final speed, km/h"),
+    accel_g: float = typer.Option(0.6, "--accel-g", help="target acceleration, g"),
+    duration: float = DurationAutoOpt,
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
+) -> None:
+    """Straight-line acceleration: from 0.5 s the powertrain follows a speed ramp at --accel-g
+    (rising over 0.2 s) to --final-speed-kmh through the rear wheels; mean and peak ax, time
+    and distance to the final speed, squat (pitch per g) and the axle loads."""
+    _straight_line("accelerate", speed_kmh, final_speed_kmh, accel_g, duration, vehicle, modes, rigid, form, rtol,
+                   out_dir, as_json, quiet, param)
+
+
+@app.command("brake")
+def brake(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    speed_kmh: float = typer.Option(100.0, "--speed-kmh", help="start speed, km/h"),
+    final_speed_kmh: float = typer.Option(20.0, "--final-speed-kmh", help="final speed, km/h (> 0)"),
+    decel_g: float = typer.Option(1.0, "--decel-g", help="target deceleration, g (> 0)"),
+    duration: float = DurationAutoOpt,
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
+) -> None:
+    """Straight-line braking: from 0.5 s the brakes follow a speed ramp at --decel-g (rising
+    over 0.2 s) to --final-speed-kmh, the torque split between the axles by the car's
+    brake_front_share; mean and peak deceleration, time and distance to the final speed,
+    dive (pitch per g) and the axle load and torque shares."""
+    _straight_line("brake", speed_kmh, final_speed_kmh, decel_g, duration, vehicle, modes, rigid, form, rtol,
+                   out_dir, as_json, quiet, param)
+
+
 PreviewOpt = typer.Option(0.8, "--preview-s", help="driver's preview time, s (preview distance = speed x time)")
 LagOpt = typer.Option(0.1, "--lag-s", help="driver's steering lag, s")
 

@@ -9,10 +9,13 @@ root finding (:mod:`._steady`)."""
 from ._channels import PATH_CHANNELS as PATH_CHANNELS, UNITS as UNITS, car_channels as car_channels
 from ._driver import (
     AbstractSteeringLaw as AbstractSteeringLaw,
+    ConstantSteer as ConstantSteer,
     Manoeuvre as Manoeuvre,
     RampSteer as RampSteer,
     StepSteer as StepSteer,
     SweptSine as SweptSine,
+    accelerate as accelerate,
+    brake as brake,
     kink_times as kink_times,
     step_steer as step_steer,
 )
@@ -24,6 +27,7 @@ from ._metrics import (
     lane_change_metrics as lane_change_metrics,
     ramp_steer_metrics as ramp_steer_metrics,
     step_steer_metrics as step_steer_metrics,
+    straight_line_metrics as straight_line_metrics,
 )
 from ._paths import (
     ISO_3888_1_SECTIONS as ISO_3888_1_SECTIONS,

@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._core import GRAVITY
-from ..vehicle import CORNERS, Car, PushrodSuspension, TyreContact, chassis_twist, wheel_centres
+from ..vehicle import CORNERS, Car, Powertrain, PushrodSuspension, TyreContact, chassis_twist, wheel_centres
 
 #: Channel name -> unit (per corner channels hold FL, FR, RL, RR on their last axis).
 UNITS = {
@@ -35,6 +35,7 @@ UNITS = {
     "road_wheel_angle": "deg",
     "spring_length": "m",
     "spring_force": "N",
+    "wheel_torque": "Nm",
 }
 #: The channels of the car's place and heading on the ground (not states of a steady turn).
 PATH_CHANNELS = ("x", "y", "heading")
@@ -50,6 +51,19 @@ def _aux_slices(elements):
 
 def _element(elements, kind):
     return [(e, s) for e, s in zip(elements, _aux_slices(elements)) if isinstance(e, kind)]
+
+
+def _wheel_torques(car: Car, elements: tuple, kin, aux):
+    """Drive (positive) and brake (negative) torque on each wheel (N m, FL, FR, RL, RR) from
+    the powertrain, zeros without one."""
+    out = jnp.zeros(4)
+    hubs = [car.system.point_index(f"{c}.hub") for c in CORNERS]
+    for e, s in _element(elements, Powertrain):
+        drive, brake = e.split(e.control(kin, aux[s])[0])
+        for points, torques in ((e.wheels, drive), (e.brake_wheels, brake)):
+            for k, point in enumerate(points):
+                out = out.at[hubs.index(point)].add(torques[k])
+    return out
 
 
 def car_channels(car: Car, elements: tuple, kin, aux, chassis_velocity, chassis_acceleration, steering_angle):
@@ -104,4 +118,5 @@ def car_channels(car: Car, elements: tuple, kin, aux, chassis_velocity, chassis_
         "road_wheel_angle": jnp.arctan2(-rel[:, 0, 1], rel[:, 1, 1]) * deg,
         "spring_length": jnp.concatenate(lengths),
         "spring_force": jnp.concatenate(forces),
+        "wheel_torque": _wheel_torques(car, elements, kin, aux),
     }

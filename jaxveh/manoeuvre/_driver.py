@@ -1,7 +1,9 @@
 """Open-loop driver: steering-wheel angle laws (rad, positive to the left) and the
 manoeuvre they (or the closed-loop driver of :mod:`._pursuit`) make with a held speed
 (section 6.1.5 "driver model"; the speed is held by the powertrain's PID,
-:class:`jaxveh.vehicle.SpeedPID`).
+:class:`jaxveh.vehicle.SpeedPID`), or with a change of speed (straight-line acceleration and
+braking, :func:`accelerate` and :func:`brake`: the PID follows a
+:class:`jaxveh.vehicle.SpeedChange`).
 
 Every law is an Equinox module with float leaves, so a manoeuvre is a pytree: its
 amplitude, timing and speed can be traced, swept with ``vmap`` and differentiated.
@@ -10,11 +12,13 @@ amplitude, timing and speed can be traced, swept with ``vmap`` and differentiate
 import abc
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
+from .._core import GRAVITY, ParameterError, is_concrete
 from ..params import Range, checked_field
-from ..vehicle import AbstractRoad, FlatRoad
+from ..vehicle import AbstractRoad, AbstractSpeedTarget, FlatRoad, SpeedChange
 
 _ANGLE = Range(-3.0, 3.0, what="steering-wheel angle, rad")
 _TIME = Range(0.0, what="time, s")
@@ -31,6 +35,15 @@ class AbstractSteeringLaw(eqx.Module):
         """Times (s) where a derivative of the angle jumps: the integrator ends its steps
         there instead of stepping across them (none by default)."""
         return ()
+
+
+class ConstantSteer(AbstractSteeringLaw):
+    """A steering-wheel angle held at ``angle`` (rad; 0: straight ahead)."""
+
+    angle: Float[Array, ""] = checked_field("ConstantSteer.angle", _ANGLE, default=0.0)
+
+    def __call__(self, t):
+        return self.angle + jnp.zeros_like(t)
 
 
 class StepSteer(AbstractSteeringLaw):
@@ -93,15 +106,29 @@ def sweep_phase(t, f0, f1, sweep, start):
 class Manoeuvre(eqx.Module):
     """A manoeuvre from straight running: the ``steering`` (an open-loop law of time, or a
     closed-loop driver such as :class:`jaxveh.manoeuvre.PurePursuit`), the ``speed`` held
-    (m/s), the ``duration`` (s) and the ``road`` (flat by default; a
+    (m/s), the ``duration`` (s), the ``road`` (flat by default; a
     :class:`jaxveh.manoeuvre.PostSweep` for the four-post rig; its height at the start must
-    be zero: the run starts from straight running on a flat road)."""
+    be zero: the run starts from straight running on a flat road) and the ``speed_target``
+    the powertrain and brakes follow (default: hold ``speed``; a
+    :class:`jaxveh.vehicle.SpeedChange` from ``speed`` for acceleration and braking)."""
 
     steering: eqx.Module
     speed: Float[Array, ""] = checked_field("Manoeuvre.speed", Range(0.0, 100.0, low_open=True, what="speed, m/s"))
     duration: Float[Array, ""] = checked_field("Manoeuvre.duration",
                                                Range(0.0, 600.0, low_open=True, what="duration, s"))
     road: AbstractRoad = FlatRoad()
+    speed_target: AbstractSpeedTarget | None = None
+
+    def __check_init__(self):
+        target = self.speed_target
+        if target is not None and not isinstance(target, AbstractSpeedTarget):
+            raise ParameterError(f"Manoeuvre.speed_target is a {type(target).__name__}: allowed None (hold the "
+                                 "speed) or a jaxveh.vehicle speed target such as SpeedChange")
+        if isinstance(target, SpeedChange) and is_concrete(target.speed) and is_concrete(self.speed):
+            if abs(float(target.speed) - float(self.speed)) > 1e-9 * float(self.speed):
+                raise ParameterError(f"Manoeuvre.speed_target starts at {float(target.speed):g} m/s where the "
+                                     f"manoeuvre starts at {float(self.speed):g} m/s: they must be equal (the run "
+                                     "starts from straight running at Manoeuvre.speed)")
 
 
 def step_steer(speed: float = 25.0, angle: float = 0.1, start: float = 0.5, rise: float = 0.2,
@@ -111,11 +138,46 @@ def step_steer(speed: float = 25.0, angle: float = 0.1, start: float = 0.5, rise
     return Manoeuvre(steering=StepSteer(amplitude=angle, start=start, rise=rise), speed=speed, duration=duration)
 
 
+def _straight_line(speed, final_speed, acceleration, start, rise, duration, settle) -> Manoeuvre:
+    change = SpeedChange(speed=speed, final_speed=final_speed, rate=acceleration * GRAVITY, start=start, rise=rise)
+    if duration is None:
+        duration = float(start + change.change_time() + rise + settle)
+    return Manoeuvre(steering=ConstantSteer(), speed=speed, duration=duration, speed_target=change)
+
+
+def accelerate(speed: float = 30 / 3.6, final_speed: float = 90 / 3.6, acceleration: float = 0.6,
+               start: float = 0.5, rise: float = 0.2, duration: float | None = None,
+               settle: float = 1.0) -> Manoeuvre:
+    """Straight-line acceleration from ``speed`` to ``final_speed`` (m/s) at ``acceleration``
+    (g) from ``start`` (s), the target's acceleration rising and falling over ``rise`` (s)
+    (:class:`jaxveh.vehicle.SpeedChange`), steering wheel held straight; ``duration``
+    (default: the change and ``settle`` seconds after)."""
+    if not float(final_speed) > float(speed):
+        raise ParameterError(f"final_speed = {float(final_speed):g} m/s must exceed speed = {float(speed):g} m/s "
+                             "(accelerate; brake for a lower speed)")
+    return _straight_line(speed, final_speed, acceleration, start, rise, duration, settle)
+
+
+def brake(speed: float = 100 / 3.6, final_speed: float = 20 / 3.6, deceleration: float = 1.0, start: float = 0.5,
+          rise: float = 0.2, duration: float | None = None, settle: float = 1.0) -> Manoeuvre:
+    """Straight-line braking from ``speed`` to ``final_speed`` (m/s, > 0: the tyre model needs
+    rolling wheels) at ``deceleration`` (g, > 0) from ``start`` (s), as :func:`accelerate`;
+    the brake torque is split between the axles by ``SpeedPID.brake_front_share``."""
+    if not float(final_speed) < float(speed):
+        raise ParameterError(f"final_speed = {float(final_speed):g} m/s must be below speed = {float(speed):g} m/s "
+                             "(brake; accelerate for a higher speed)")
+    return _straight_line(speed, final_speed, deceleration, start, rise, duration, settle)
+
+
 def kink_times(manoeuvre: Manoeuvre):
-    """The times (s) where the manoeuvre's steering or road input has a derivative jump
-    (``kinks()`` of either; closed-loop drivers have none), as an array for Diffrax's
+    """The times (s) where the manoeuvre's steering, road or speed target has a derivative
+    jump (``kinks()`` of each; closed-loop drivers have none), as an array for Diffrax's
     ``PIDController(jump_ts=...)``, or None. Steps that end there are not rejected for the
-    jump: 302 -> 274 steps and 30 -> 10 rejections on the benchmark step steer."""
+    jump: 302 -> 274 steps and 30 -> 10 rejections on the benchmark step steer. They are held
+    out of differentiation, so a law's timing (a step's ``rise``, a speed change's ``rate``)
+    can be differentiated through the run."""
     steering = manoeuvre.steering.kinks() if isinstance(manoeuvre.steering, AbstractSteeringLaw) else ()
-    times = [*steering, *manoeuvre.road.kinks()]
-    return jnp.stack([jnp.asarray(t, jnp.float64) for t in times]) if times else None
+    speed = manoeuvre.speed_target.kinks() if manoeuvre.speed_target is not None else ()
+    times = [*steering, *manoeuvre.road.kinks(), *speed]
+    # step boundaries only: held out of differentiation (the solution does not depend on them)
+    return jax.lax.stop_gradient(jnp.stack([jnp.asarray(t, jnp.float64) for t in times])) if times else None

@@ -2,8 +2,9 @@
 
 import numpy as np
 
-from .._core import ParameterError
+from .._core import GRAVITY, ParameterError
 from ..analytic._transient import _first_crossing
+from ..vehicle import SpeedChange
 from ._driver import StepSteer
 from ._paths import Circle, DoubleLaneChange
 
@@ -208,3 +209,54 @@ def four_post_metrics(ts, channels: dict, f_range=(0.5, 30.0), window_sigma: flo
     out["frequency_response"] = {"frequency_hz": f.tolist()} | {
         f"{name}_gain": frf[f"{name}_gain"].tolist() for name in outputs}
     return out
+
+
+def straight_line_metrics(ts, channels: dict, target: SpeedChange, settle_time: float = 0.5) -> dict:
+    """Metrics of straight-line acceleration or braking toward ``target`` (the manoeuvre's
+    :class:`jaxveh.vehicle.SpeedChange`; the run must end settled at the final speed). The
+    hold window runs from ``settle_time`` (s) after the target reaches its full rate to the
+    end of the hold; over it: the mean longitudinal acceleration ``ax_mean_g`` (negative
+    braking) against the target's ``ax_target_g``, the mean pitch (``pitch_mean_deg``;
+    positive nose down) and the pitch per g of ax (``pitch_gradient_deg_per_g``: the pitch
+    less straight running's at the same speed, interpolated linearly in the speed squared
+    between the run's first and last samples as the aero loads grow, over the mean ax;
+    negative: the nose dives when braking and rises when accelerating), the front axle's mean share of the tyre loads
+    (``front_load_share``) and of the wheel torques (``front_torque_share``: the brake
+    balance when braking, 0 for the rear-wheel drive). ``time_to_final_speed_s``: from the
+    target's start until the speed first comes within 1 % of the change from its final
+    value; ``distance_m``: travelled over that time; ``peak_ax_g``: the largest ax in the
+    direction of the change."""
+    ts = np.asarray(ts, float)
+    start, rise, rate = float(target.start), float(target.rise), float(target.rate)
+    v0, v1 = float(target.speed), float(target.final_speed)
+    sign = 1.0 if v1 > v0 else -1.0
+    hold = (ts >= start + rise + settle_time) & (ts <= start + abs(v1 - v0) / rate)
+    if hold.sum() < 3:
+        raise ParameterError(f"the hold at the full rate is too short for the metrics: fewer than 3 save times "
+                             f"between {start + rise + settle_time:g} s and {start + abs(v1 - v0) / rate:g} s "
+                             "(a larger speed change, a lower rate, more points or a shorter settle_time)")
+    speed, ax = np.asarray(channels["speed"]), np.asarray(channels["ax"])
+    reached = sign * (speed - v1) >= -0.01 * abs(v1 - v0)
+    after = ts >= start
+    if not np.any(reached & after):
+        raise ParameterError(f"the speed never came within 1 % of the change from {v1:g} m/s: a longer duration, "
+                             "or the car cannot follow the target (tyre grip, torque limits)")
+    end = int(np.argmax(reached & after))
+    window = (ts >= start) & (ts <= ts[end])
+    distance = float(np.sum(0.5 * (speed[window][1:] + speed[window][:-1]) * np.diff(ts[window])))
+    fz, torque = np.asarray(channels["fz"]), np.asarray(channels["wheel_torque"])
+    # straight running's own pitch at each speed (aero loads grow with v^2): linear in v^2
+    # between the start and the settled end of the run
+    pitch = np.asarray(channels["pitch"])
+    pitch_straight = pitch[0] + (pitch[-1] - pitch[0]) * (speed ** 2 - speed[0] ** 2) / (speed[-1] ** 2 - speed[0] ** 2)
+    return {
+        "ax_target_g": sign * rate / GRAVITY,
+        "ax_mean_g": float(ax[hold].mean()),
+        "peak_ax_g": float(sign * np.max(sign * ax)),
+        "time_to_final_speed_s": float(ts[end] - start),
+        "distance_m": distance,
+        "pitch_mean_deg": float(pitch[hold].mean()),
+        "pitch_gradient_deg_per_g": float((pitch - pitch_straight)[hold].mean() / ax[hold].mean()),
+        "front_load_share": float((fz[hold, :2].sum(axis=1) / fz[hold].sum(axis=1)).mean()),
+        "front_torque_share": float((torque[hold, :2].sum(axis=1) / torque[hold].sum(axis=1)).mean()),
+    }

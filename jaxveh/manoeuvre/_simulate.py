@@ -144,7 +144,8 @@ def _check_steering(manoeuvre: Manoeuvre):
 def _driving(car, manoeuvre: Manoeuvre, trim_rack, pose: int) -> _Driving:
     """Open-loop laws steer as functions of time; a :class:`PurePursuit` driver steers
     from its own state (the chassis's x coordinate at ``q[pose]``)."""
-    elements = car_elements(car, ConstantSpeed(manoeuvre.speed), road=manoeuvre.road)
+    target = ConstantSpeed(manoeuvre.speed) if manoeuvre.speed_target is None else manoeuvre.speed_target
+    elements = car_elements(car, target, road=manoeuvre.road)
     steering = _check_steering(manoeuvre)
     if isinstance(steering, AbstractSteeringLaw):
         law = mb.TimeInputs(lambda t: trim_rack + steering_rack(car, steering(t)))

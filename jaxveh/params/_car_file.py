@@ -37,8 +37,11 @@ POWERTRAIN = (
              lower_open=False),
     Quantity("kd", "Nm s2/m", "PID derivative gain", "section 6.1.5", lower_open=False),
     Quantity("tau", "s", "speed filter time constant of the derivative", _CHOICE),
-    Quantity("torque_min", "Nm", "most negative (braking) rear-wheel torque", _CHOICE, lower=None, upper=0.0),
+    Quantity("torque_min", "Nm", "most negative (braking) torque of the four wheels together", _CHOICE, lower=None,
+             upper=0.0),
     Quantity("torque_max", "Nm", "largest rear-wheel drive torque", _CHOICE, lower_open=False),
+    Quantity("brake_front_share", "-", "front axle's share of the brake torque", _CHOICE, lower_open=False,
+             upper=1.0),
 )
 CHASSIS = (
     Quantity("damping_ratio", "-", "modal damping ratio of every chassis mode", "section 7.3", lower_open=False,

@@ -32,6 +32,7 @@ from ._car import (
     load_car as load_car,
     rest_spring_preloads as rest_spring_preloads,
     set_car_params as set_car_params,
+    speed_feedforward as speed_feedforward,
     sprung_cg as sprung_cg,
     static_corner_loads as static_corner_loads,
     steering as steering,
@@ -87,6 +88,7 @@ from ._powertrain import (
     AbstractSpeedTarget as AbstractSpeedTarget,
     ConstantSpeed as ConstantSpeed,
     Powertrain as Powertrain,
+    SpeedChange as SpeedChange,
     SpeedPID as SpeedPID,
 )
 from ._pushrod import (

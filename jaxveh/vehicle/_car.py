@@ -352,8 +352,8 @@ def car_elements(car: Car, speed_target: AbstractSpeedTarget | None = None, road
                  powertrain: bool = True, tyre_horizontal: bool = True) -> tuple:
     """Force elements of the car: front and rear push-rod suspensions (with their anti-roll
     bars), the four tyres (``tyre_horizontal=False``: normal loads only), aerodynamics and
-    (with ``powertrain``) the rear-wheel drive aiming at ``speed_target`` (default: hold
-    0 m/s)."""
+    (with ``powertrain``) the rear-wheel drive and the four brakes aiming at ``speed_target``
+    (default: hold 0 m/s)."""
     p, system = car.params, car.system
     hp = corner_hard_points(p.vehicle)
     laws = [jax.tree.map(lambda x, k=k: x[k], p.springs) for k in range(4)]
@@ -366,9 +366,17 @@ def car_elements(car: Car, speed_target: AbstractSpeedTarget | None = None, road
     elements = (front, rear, tyres, aero)
     if powertrain:
         target = ConstantSpeed(0.0) if speed_target is None else speed_target
+        brakes = tuple((f"{c}.hub", f"{c}.W", c.startswith("front")) for c in CORNERS)
         elements += (Powertrain.on(system, "chassis", "chassis.cg", ("rear_left.hub", "rear_right.hub"),
-                                   "chassis.differential", p.pid, target),)
+                                   "chassis.differential", p.pid, target, brakes, speed_feedforward(p)),)
     return elements
+
+
+def speed_feedforward(params: CarParams) -> Float[Array, ""]:
+    """The powertrain's feedforward gain (N m per m/s^2): the wheel torque that accelerates
+    the car's total mass at the tyres' mean unloaded radius (the wheels' spin inertia and the
+    loaded radius are left to the PI loop)."""
+    return total_mass(params.vehicle) * jnp.mean(params.tyres.unloaded_radius)
 
 
 def steering_rack(car: Car, steering_wheel_angle):
@@ -479,7 +487,7 @@ def load_car(path: str | Path | None = None, modes: int = 6, form: str = "fast")
         tyres=tyres,
         aero=aero_map_from_coefficients(a["cda"], a["cla"], a["front_share"], a["density"], a["max_speed"]),
         pid=SpeedPID(kp=pt["kp"], ki=pt["ki"], kd=pt["kd"], tau=pt["tau"], t_min=pt["torque_min"],
-                     t_max=pt["torque_max"]),
+                     t_max=pt["torque_max"], brake_front_share=pt["brake_front_share"]),
         rack_ratio=as_float(file.sections["steering"]["rack_ratio"]),
     )
     system, template = _build_system(v, chassis)
