@@ -188,7 +188,8 @@ class Powertrain(AbstractForceElement):
         n_front = sum(self.brake_front)
         shares = jnp.stack([front / n_front if f else (1.0 - front) / (len(self.brake_front) - n_front)
                             for f in self.brake_front])
-        return jnp.full(len(self.wheels), jnp.maximum(torque, 0.0) / len(self.wheels)), jnp.minimum(torque, 0.0) * shares
+        drive = jnp.full(len(self.wheels), jnp.maximum(torque, 0.0) / len(self.wheels))
+        return drive, jnp.minimum(torque, 0.0) * shares
 
     def __call__(self, kin, aux, system):
         torque, integral_rate, filter_rate = self.control(kin, aux)
