@@ -9,10 +9,10 @@ root finding (:mod:`._steady`)."""
 from ._channels import PATH_CHANNELS as PATH_CHANNELS, UNITS as UNITS, car_channels as car_channels
 from ._driver import (
     AbstractSteeringLaw as AbstractSteeringLaw,
-    ConstantSteer as ConstantSteer,
     Manoeuvre as Manoeuvre,
     RampSteer as RampSteer,
     StepSteer as StepSteer,
+    Straight as Straight,
     SweptSine as SweptSine,
     accelerate as accelerate,
     brake as brake,
@@ -47,7 +47,6 @@ from ._reports import skid_pad_grid as skid_pad_grid, skid_pad_report as skid_pa
 from ._road import (
     POST_PATTERNS as POST_PATTERNS,
     PostSweep as PostSweep,
-    Straight as Straight,
     four_post as four_post,
 )
 from ._simulate import (

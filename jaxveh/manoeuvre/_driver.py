@@ -37,13 +37,11 @@ class AbstractSteeringLaw(eqx.Module):
         return ()
 
 
-class ConstantSteer(AbstractSteeringLaw):
-    """A steering-wheel angle held at ``angle`` (rad; 0: straight ahead)."""
-
-    angle: Float[Array, ""] = checked_field("ConstantSteer.angle", _ANGLE, default=0.0)
+class Straight(AbstractSteeringLaw):
+    """No steering: the steering wheel held at the straight-running angle."""
 
     def __call__(self, t):
-        return self.angle + jnp.zeros_like(t)
+        return jnp.zeros_like(jnp.asarray(t, jnp.float64))
 
 
 class StepSteer(AbstractSteeringLaw):
@@ -142,7 +140,7 @@ def _straight_line(speed, final_speed, acceleration, start, rise, duration, sett
     change = SpeedChange(speed=speed, final_speed=final_speed, rate=acceleration * GRAVITY, start=start, rise=rise)
     if duration is None:
         duration = float(start + change.change_time() + rise + settle)
-    return Manoeuvre(steering=ConstantSteer(), speed=speed, duration=duration, speed_target=change)
+    return Manoeuvre(steering=Straight(), speed=speed, duration=duration, speed_target=change)
 
 
 def accelerate(speed: float = 30 / 3.6, final_speed: float = 90 / 3.6, acceleration: float = 0.6,

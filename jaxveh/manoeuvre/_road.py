@@ -16,7 +16,7 @@ from jaxtyping import Array, Float
 from .._core import ParameterError
 from ..params import Range, checked_field
 from ..vehicle import AbstractRoad
-from ._driver import AbstractSteeringLaw, Manoeuvre, sweep_phase
+from ._driver import Manoeuvre, Straight, sweep_phase
 
 #: Post phase of each corner (FL, FR, RL, RR) by pattern.
 POST_PATTERNS = {"heave": (1.0, 1.0, 1.0, 1.0), "warp": (1.0, -1.0, -1.0, 1.0)}
@@ -52,13 +52,6 @@ class PostSweep(AbstractRoad):
     def kinks(self):
         """Start and end of the sweep (s): derivative jumps of the post motion."""
         return (self.start, self.start + self.sweep)
-
-
-class Straight(AbstractSteeringLaw):
-    """No steering: the steering wheel held at the straight-running angle."""
-
-    def __call__(self, t):
-        return jnp.zeros_like(jnp.asarray(t, jnp.float64))
 
 
 def four_post(speed: float = 50.0 / 3.6, pattern: str = "warp", amplitude: float = 0.002, f0: float = 0.0,
