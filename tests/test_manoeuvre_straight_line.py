@@ -164,9 +164,9 @@ def test_dive_gradient_equals_central_differences(car):
     assert abs(grad[0]) > 1e-3 and abs(grad[1]) > 1e-3  # both matter
 
 
-def test_cli_brake_json():
+def test_cli_brake_json(tmp_path):
     result = CliRunner().invoke(app, ["simulate", "brake", "--rigid", "--json", "--speed-kmh", "80",
-                                      "--final-speed-kmh", "30", "--decel-g", "0.8"])
+                                      "--final-speed-kmh", "30", "--decel-g", "0.8", "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
     out = json.loads(result.output)
     assert out["manoeuvre"] == "brake" and out["stop_reason"] == "completed"
@@ -177,6 +177,9 @@ def test_cli_brake_json():
     for key in ("time_to_final_speed_s", "peak_ax_g", "pitch_gradient_deg_per_g", "front_load_share",
                 "front_torque_share", "wall_time_s", "steps"):
         assert key in out
+    assert (tmp_path / "brake.png").stat().st_size > 0
+    header = (tmp_path / "brake.csv").read_text().splitlines()[0].split(",")
+    assert "wheel_torque_fl_Nm" in header and "speed_m/s" in header
 
 
 @pytest.mark.parametrize("args, match", [

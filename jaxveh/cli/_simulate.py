@@ -65,7 +65,7 @@ def _say(quiet: bool, message: str) -> None:
         typer.echo(message, err=True)
 
 
-def _write(out_dir: Path, name: str, run, report: dict) -> None:
+def _write(out_dir: Path, name: str, run, report: dict, panels=None) -> None:
     from .. import plots
     from ..manoeuvre import UNITS, write_netcdf
 
@@ -89,13 +89,16 @@ def _write(out_dir: Path, name: str, run, report: dict) -> None:
     attrs = {k: v for k, v in report.items() if isinstance(v, (str, int, float)) and not isinstance(v, bool)}
     write_netcdf(run, out_dir / f"{name}.nc", attrs)
     history = {"t_s": np.asarray(run.ts)} | {k: np.asarray(v) for k, v in run.channels.items()}
-    plots.save(plots.plot_manoeuvre({report["chassis"]: history}, title=report["title"]), out_dir / f"{name}.png")
+    panels = {} if panels is None else {"panels": panels}
+    plots.save(plots.plot_manoeuvre({report["chassis"]: history}, title=report["title"], **panels),
+               out_dir / f"{name}.png")
 
 
 def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics=None,
-         points: int = 501, figures=None, settings=None):
+         points: int = 501, figures=None, settings=None, panels=None):
     """Simulate, report (plus ``metrics(run)``), write the files (plus ``figures(report)``:
-    name -> figure) and print."""
+    name -> figure; ``panels``: the time plot's, :func:`jaxveh.plots.plot_manoeuvre`) and
+    print."""
     from ..manoeuvre import simulate
 
     _compilation_cache()
@@ -126,7 +129,7 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
         report |= metrics(run, car)
     report["title"] = f"{name} at {report['speed_kmh']:g} km/h, {report['chassis']} ({form} form)"
     if out_dir is not None:
-        _write(out_dir, name.replace("-", "_"), run, report)
+        _write(out_dir, name.replace("-", "_"), run, report, panels)
         if figures is not None:
             from .. import plots
 
@@ -302,7 +305,10 @@ def _straight_line(name: str, speed_kmh, final_speed_kmh, rate_g, duration, vehi
         except ParameterError as e:
             return out | {"metrics_error": str(e)}
 
-    _run(name, m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, settings=param)
+    from ..plots import STRAIGHT_LINE_PANELS
+
+    _run(name, m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, settings=param,
+         panels=STRAIGHT_LINE_PANELS)
 
 
 DurationAutoOpt = typer.Option(None, "--duration", help="s (default: the speed change and 1 s after)")

@@ -19,6 +19,7 @@ from ._kinematics import (
     plot_simplifications as plot_simplifications,
 )
 from ._manoeuvres import (
+    STRAIGHT_LINE_PANELS as STRAIGHT_LINE_PANELS,
     plot_four_post as plot_four_post,
     plot_frequency_response as plot_frequency_response,
     plot_manoeuvre as plot_manoeuvre,

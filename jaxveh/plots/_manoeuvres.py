@@ -13,20 +13,35 @@ _PANELS = (
     ("sideslip", "β [deg]", None),
     ("modes", "modal coordinates [-]", "all"),
 )
+#: Panels of straight-line acceleration and braking (per corner: FL, FR, RL, RR).
+STRAIGHT_LINE_PANELS = (
+    ("speed", "speed [m/s]", None),
+    ("ax", "ax [g]", None),
+    ("pitch", "pitch [deg] (nose down +)", None),
+    ("fz", "tyre load Fz [N]", "corners"),
+    ("wheel_torque", "wheel torque [N m] (brake -)", "corners"),
+    ("modes", "modal coordinates [-]", "all"),
+)
+_CORNERS = ("FL", "FR", "RL", "RR")
 
 
-def plot_manoeuvre(runs: dict, title: str = "", t_max: float | None = None):
-    """Steering, ay, yaw rate, roll, sideslip and the modal coordinates of one or more runs
-    (``{label: {"t_s": ..., channel: ...}}``, channels as from
-    :func:`jaxveh.manoeuvre.simulate`)."""
+def plot_manoeuvre(runs: dict, title: str = "", t_max: float | None = None, panels=_PANELS):
+    """Six panels of one or more runs (``{label: {"t_s": ..., channel: ...}}``, channels as
+    from :func:`jaxveh.manoeuvre.simulate`): by default steering, ay, yaw rate, roll,
+    sideslip and the modal coordinates; ``panels``: ``(channel, axis label, which)`` with
+    ``which`` None, "corners" or "all" (the modal coordinates), e.g.
+    :data:`STRAIGHT_LINE_PANELS`."""
     fig, axes = figure(3, 2, figsize=(10, 9))
     styles = ("-", "--", "-.", ":")
-    for ax, (key, ylabel, which) in zip(axes.flat, _PANELS):
+    for ax, (key, ylabel, which) in zip(axes.flat, panels):
         for (label, run), style in zip(runs.items(), styles):
             y = np.asarray(run[key])
             if which == "all":
                 for k in range(y.shape[1] if y.ndim == 2 else 0):
                     ax.plot(run["t_s"], y[:, k], style, label=f"{label} mode {k + 1}")
+            elif which == "corners":
+                for k, corner in enumerate(_CORNERS):
+                    ax.plot(run["t_s"], y[:, k], style, label=f"{label} {corner}")
             else:
                 ax.plot(run["t_s"], y, style, label=label)
         ax.set_xlabel("t [s]")
