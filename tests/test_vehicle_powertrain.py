@@ -76,3 +76,47 @@ def test_named_errors():
     with pytest.raises(ParameterError, match="kp"):
         vehicle.SpeedPID(kp=-1.0, ki=1.0)
     assert jax.tree.leaves(vehicle.ConstantSpeed(3.0))  # a pytree: the speed is a leaf
+
+
+def test_brakes_take_a_negative_torque_with_their_reactions_on_the_mounts(rig):
+    """Too fast for the target: the torque is negative and goes to the brakes (front share on
+    the 'front' entry, the rest on the 'rear' one, both on the flywheel here), reacted on the
+    mounts; nothing through the differential. Net torque zero; the flywheel decelerates by
+    T / J."""
+    system, params, pt = rig
+    pid = vehicle.SpeedPID(kp=KP, ki=KI, brake_front_share=0.7)
+    braked = vehicle.Powertrain.on(system, "fly", "rim", ("hub", "hub"), "base", pid, vehicle.ConstantSpeed(V_REF),
+                                   brakes=(("hub", "base", True), ("hub", "base", False)))
+    aux = jnp.asarray([0.0, 12.0 * R])
+    dyn = mb.dynamics(system, params, jnp.zeros(1), jnp.asarray([60.0]), 0.0, elements=(braked,), aux=aux)
+    torque, _, _ = braked.control(dyn.kinematics, aux)
+    assert float(torque) < 0.0
+    drive, brake = braked.split(torque)
+    np.testing.assert_allclose(drive, 0.0, atol=0.0)
+    np.testing.assert_allclose(brake, [0.7 * float(torque), 0.3 * float(torque)], rtol=1e-12)
+    out = braked(dyn.kinematics, aux, system)
+    np.testing.assert_allclose(jnp.sum(out.torques, axis=0), 0.0, atol=1e-12)
+    np.testing.assert_allclose(out.torques[system.point_index("hub")], [0.0, float(torque), 0.0], rtol=1e-12)
+    np.testing.assert_allclose(float(dyn.z_dot[0]), float(torque) / J, rtol=1e-12)
+    # below the target the same element drives through the differential, brakes off
+    slow = mb.dynamics(system, params, jnp.zeros(1), jnp.asarray([4.0]), 0.0, elements=(braked,), aux=jnp.zeros(2))
+    torque, _, _ = braked.control(slow.kinematics, jnp.zeros(2))
+    drive, brake = braked.split(torque)
+    assert float(torque) > 0.0 and np.all(np.asarray(brake) == 0.0)
+    np.testing.assert_allclose(drive, [float(torque) / 2] * 2, rtol=1e-12)
+
+
+def test_feedforward_follows_the_target_acceleration(rig):
+    """With the feedforward gain J / R and no error, the torque is exactly what accelerates the
+    flywheel's rim at the target's rate."""
+    system, params, pt = rig
+    target = vehicle.SpeedChange(speed=V_REF, final_speed=2.0 * V_REF, rate=3.0, start=0.0, rise=0.1)
+    ff = vehicle.Powertrain.on(system, "fly", "rim", ("hub", "hub"), "base", vehicle.SpeedPID(kp=KP, ki=KI), target,
+                               feedforward=J / R)
+    t = 0.5  # in the hold: target acceleration 3 m/s^2
+    u = float(target(t))
+    dyn = mb.dynamics(system, params, jnp.zeros(1), jnp.asarray([u / R]), t, elements=(ff,),
+                      aux=jnp.asarray([0.0, u]))
+    torque, _, _ = ff.control(dyn.kinematics, jnp.asarray([0.0, u]))
+    np.testing.assert_allclose(float(torque), J / R * 3.0, rtol=1e-9)
+    np.testing.assert_allclose(float(dyn.z_dot[0]) * R, 3.0, rtol=1e-9)
