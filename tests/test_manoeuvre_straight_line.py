@@ -192,7 +192,9 @@ def test_cli_refuses_bad_input(args, match):
     assert result.exit_code != 0 and match in result.output
 
 
-def test_bad_input_is_named():
+def test_bad_input_is_named(car):
+    with pytest.raises(ParameterError, match="pid.brake_front_share"):
+        with_params(car, {"pid.brake_front_share": 1.5})
     with pytest.raises(ParameterError, match="SpeedChange.rate"):
         SpeedChange(speed=20.0, final_speed=10.0, rate=0.0)
     with pytest.raises(ParameterError, match="SpeedChange.final_speed"):

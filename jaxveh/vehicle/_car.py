@@ -226,14 +226,15 @@ def _build_system(vehicle: VehicleData, modal) -> tuple[System, SystemParams]:
 def check_car(car: Car) -> Car:
     """Run every check the car's compiled programs would run on its parameters: the tyres'
     coefficients, the chassis's modal stiffness multipliers and damping, the anti-roll-bar
-    rates (>= 0) and the library parameters (masses, inertias, coupling, link lengths,
-    points, gravity). Concrete
+    rates (>= 0), the speed controller's gains, limits and brake balance, and the library
+    parameters (masses, inertias, coupling, link lengths, points, gravity). Concrete
     values raise :class:`~jaxveh.ParameterError` naming the value (traced ones fail at run
     time); returns ``car``. Entry points that compile the car without run-time checks
     (:func:`jaxveh._core.run_time_checks_off`) call this first, so a leaf set out of range
     with ``eqx.tree_at`` is still refused by name."""
     p = car.params
     check_range("arb_rates (N m/rad, front and rear)", p.arb_rates, low=0.0)
+    p.pid.check("pid.")
     check_tyre(p.tyres)
     if p.chassis is not None:
         for check in (p.chassis._scale, p.chassis._alpha, p.chassis._beta, p.chassis._zeta):

@@ -119,11 +119,16 @@ class SpeedPID(eqx.Module):
     brake_front_share: Float[Array, ""] = float_field(default=0.65)
 
     def __check_init__(self):
+        self.check()
+
+    def check(self, prefix: str = "") -> None:
+        """Refuse concrete values out of range, naming ``prefix`` + the field (traced gains
+        are the optimiser's business)."""
         limits = {"kp": {"low": 0.0}, "ki": {"low": 0.0}, "kd": {"low": 0.0}, "tau": {"low": 0.0, "low_open": True},
                   "t_min": {"high": 0.0}, "t_max": {"low": 0.0}, "brake_front_share": {"low": 0.0, "high": 1.0}}
         for name, bounds in limits.items():
-            if is_concrete(getattr(self, name)):  # traced gains are the optimiser's business
-                check_range(name, getattr(self, name), **bounds)
+            if is_concrete(getattr(self, name)):
+                check_range(prefix + name, getattr(self, name), **bounds)
 
     def torque(self, error, integral, error_rate, feedforward=0.0):
         """``(saturated torque, unsaturated torque)`` (N m), ``feedforward`` (N m) added."""
