@@ -89,6 +89,19 @@ def test_braking_reaches_the_target_and_splits_the_torque_by_the_brake_balance(c
     np.testing.assert_allclose(ch["fz"][:, 0], ch["fz"][:, 1], rtol=5e-3)
 
 
+def test_a_deceleration_beyond_the_car_is_flagged(car, braking):
+    """3 g is beyond the tyres and the brake torque limit: the run completes, the car brakes
+    as hard as it can, and the metrics say the target was not followed."""
+    m = brake(deceleration=3.0)
+    run = simulate(car, m)
+    assert run.stop_reason == "completed"
+    out = straight_line_metrics(run.ts, _channels(run), m.speed_target)
+    assert not out["target_followed"] and -2.0 < out["ax_mean_g"] < -0.5
+    followed = braking[1.0]
+    assert straight_line_metrics(followed.ts, _channels(followed), brake(deceleration=1.0).speed_target)[
+        "target_followed"]
+
+
 def test_the_brake_balance_is_car_data(car):
     balanced = with_params(car, {"pid.brake_front_share": 0.5})
     ch = _channels(simulate(balanced, brake(deceleration=1.0)))

@@ -211,12 +211,19 @@ def four_post_metrics(ts, channels: dict, f_range=(0.5, 30.0), window_sigma: flo
     return out
 
 
+#: ``straight_line_metrics``' ``target_followed``: the hold's mean ax within this share of the target.
+FOLLOWED = 0.05
+
+
 def straight_line_metrics(ts, channels: dict, target: SpeedChange, settle_time: float = 0.5) -> dict:
     """Metrics of straight-line acceleration or braking toward ``target`` (the manoeuvre's
     :class:`jaxveh.vehicle.SpeedChange`; the run must end settled at the final speed). The
     hold window runs from ``settle_time`` (s) after the target reaches its full rate to the
     end of the hold; over it: the mean longitudinal acceleration ``ax_mean_g`` (negative
-    braking) against the target's ``ax_target_g``, the mean pitch (``pitch_mean_deg``;
+    braking) against the target's ``ax_target_g`` (``target_followed``: within
+    :data:`FOLLOWED` of it; false when the tyres' grip or the torque limits cannot give
+    the rate, and the other metrics are then those of the car braking or accelerating as
+    hard as it can), the mean pitch (``pitch_mean_deg``;
     positive nose down) and the pitch per g of ax (``pitch_gradient_deg_per_g``: the pitch
     less straight running's at the same speed, interpolated linearly in the speed squared
     between the run's first and last samples as the aero loads grow, over the mean ax;
@@ -252,6 +259,7 @@ def straight_line_metrics(ts, channels: dict, target: SpeedChange, settle_time: 
     return {
         "ax_target_g": sign * rate / GRAVITY,
         "ax_mean_g": float(ax[hold].mean()),
+        "target_followed": bool(abs(ax[hold].mean() - sign * rate / GRAVITY) <= FOLLOWED * rate / GRAVITY),
         "peak_ax_g": float(sign * np.max(sign * ax)),
         "time_to_final_speed_s": float(ts[end] - start),
         "distance_m": distance,
