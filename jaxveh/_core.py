@@ -97,21 +97,29 @@ def check_range(name: str, value, *, low=None, high=None, low_open=False, high_o
     lo_txt = "-inf" if low is None else f"{low:g}"
     hi_txt = "inf" if high is None else f"{high:g}"
     allowed = f"{'(' if low_open or low is None else '['}{lo_txt}, {hi_txt}{')' if high_open or high is None else ']'}"
-    bad = ~jnp.isfinite(value)
+    message = f"{name} must lie in {allowed}{' (' + what + ')' if what else ''}"
+    if is_concrete(value):  # checked in NumPy: no eager JAX operation per check
+        bad = _out_of_range(np, np.asarray(value), low, high, low_open, high_open)
+        if bad.any():
+            shown = np.asarray(value)[bad].ravel()[:3]
+            raise ParameterError(f"{message}; got {', '.join(f'{v:g}' for v in shown)}")
+        return value
+    bad = _out_of_range(jnp, value, low, high, low_open, high_open)
+    if is_concrete(bad):  # e.g. under an un-jitted jax.grad: the flag is known, the value traced
+        if np.asarray(bad).any():
+            raise ParameterError(message)
+        return value
+    return eqx.error_if(value, jnp.any(bad), message)
+
+
+def _out_of_range(xp, value, low, high, low_open, high_open):
+    """Elementwise: not finite or outside ``[low, high]`` (``xp`` is NumPy or jax.numpy)."""
+    bad = ~xp.isfinite(value)
     if low is not None:
         bad = bad | ((value <= low) if low_open else (value < low))
     if high is not None:
         bad = bad | ((value >= high) if high_open else (value > high))
-    message = f"{name} must lie in {allowed}{' (' + what + ')' if what else ''}"
-    if is_concrete(bad):  # inside jit even constants give traced results
-        bad_np = np.asarray(bad)
-        if bad_np.any():
-            if not is_concrete(value):  # e.g. under an un-jitted jax.grad: the flag is known, the value traced
-                raise ParameterError(message)
-            shown = np.asarray(value)[bad_np].ravel()[:3]
-            raise ParameterError(f"{message}; got {', '.join(f'{v:g}' for v in shown)}")
-        return value
-    return eqx.error_if(value, jnp.any(bad), message)
+    return bad
 
 
 def read_toml(path: str | Path | None, package: str, default: str, kind: str) -> tuple[dict, str]:

@@ -26,7 +26,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._core import GRAVITY, ParameterError, check_range, float_field
+from .._core import GRAVITY, ParameterError, check_range, float_field, is_concrete
 from ._bodies import FlexibleBody, FlexOptions, RigidBody
 from ._rotations import SEQUENCES
 
@@ -449,8 +449,10 @@ INERTIA_PSD_RTOL = 1e-12
 
 def _check_inertia(name: str, inertia):
     """A body's inertia must be symmetric positive semi-definite (kg m^2)."""
-    w = jnp.linalg.eigvalsh(0.5 * (inertia + inertia.T))
-    smallest = w[0] / jnp.maximum(jnp.abs(w[-1]), 1.0)
+    xp = np if is_concrete(inertia) else jnp  # concrete: NumPy, no eager JAX operation
+    inertia_xp = xp.asarray(inertia)
+    w = xp.linalg.eigvalsh(0.5 * (inertia_xp + inertia_xp.T))
+    smallest = w[0] / xp.maximum(xp.abs(w[-1]), 1.0)
     check_range(f"{name} inertia (smallest eigenvalue / largest)", smallest, low=-INERTIA_PSD_RTOL)
     return check_range(f"{name} inertia", inertia, low=None)
 

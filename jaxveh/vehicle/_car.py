@@ -239,7 +239,7 @@ def check_car(car: Car) -> Car:
     if p.chassis is not None:
         for check in (p.chassis._scale, p.chassis._alpha, p.chassis._beta, p.chassis._zeta):
             check()
-    checked_params(car.system, system_params(car))
+    checked_params(car.system, _system_params_program(car))
     return car
 
 
@@ -535,3 +535,8 @@ def with_rest_preloads(car: Car, iterations: int = 8) -> Car:
 
     shift = jax.vmap(shift_one)(laws, rest, preloads)
     return eqx.tree_at(lambda c: c.params.springs.spring_length, car, laws.spring_length + shift[:, None])
+
+
+#: :func:`system_params` as one compiled program (one per car structure): the checks of
+#: :func:`check_car` read its values without a few hundred eager operations per call.
+_system_params_program = eqx.filter_jit(system_params)
