@@ -349,6 +349,71 @@ def brake(
                    out_dir, as_json, quiet, param)
 
 
+@app.command("brake-in-turn")
+def brake_in_turn(
+    vehicle: Path = VehicleOpt, modes: int = ModesOpt, rigid: bool = RigidOpt, form: str = FormOpt,
+    speed_kmh: float = typer.Option(80.0, "--speed-kmh", help="start speed, km/h"),
+    radius_m: float = typer.Option(100.0, "--radius-m", help="radius of the circle before braking, m (the steering "
+                                   "for it from the car's steady state; ignored with --steer-deg)"),
+    steer_deg: float = typer.Option(None, "--steer-deg", help="steering-wheel angle held, deg from straight "
+                                    "running's (negative: right; default: the angle for --radius-m)"),
+    right: bool = typer.Option(False, "--right", help="turn right on the --radius-m circle (default left)"),
+    decel_g: float = typer.Option(0.5, "--decel-g", help="target deceleration, g (> 0)"),
+    final_speed_kmh: float = typer.Option(None, "--final-speed-kmh", help="final speed, km/h (default: half the "
+                                          "start speed)"),
+    brake_start_s: float = typer.Option(3.0, "--brake-start-s", help="brake onset, s (the steering turns in from "
+                                        "0.5 to 0.7 s)"),
+    duration: float = DurationAutoOpt,
+    rtol: float = RtolOpt, out_dir: Path = OutOpt, as_json: bool = JsonOpt, quiet: bool = QuietOpt,
+    param: list[str] = ParamOpt,
+) -> None:
+    """Braking in a turn, open loop (after ISO 7975): the steering wheel turns in and is held,
+    the car settles on its circle, then brakes at --decel-g; 1 s after the onset the yaw rate
+    against the initial circle's at the current speed, the heading and path deviations from
+    that circle, the sideslip change and ay."""
+    import jax.numpy as jnp
+
+    from ..manoeuvre import BRAKE_IN_TURN_AFTER, brake_in_turn as make, brake_in_turn_metrics, circle_steer
+
+    if not decel_g > 0.0:
+        fail(f"--decel-g must be > 0 g, got {decel_g:g}")
+    speed = _speed(speed_kmh)
+    final_speed = 0.5 * speed if final_speed_kmh is None else final_speed_kmh / 3.6
+    if not 0.0 < final_speed < speed:
+        fail(f"--final-speed-kmh must lie in (0, --speed-kmh = {speed_kmh:g}) km/h, got {final_speed * 3.6:g}")
+    if steer_deg is None:
+        if not radius_m > 0.0:
+            fail(f"--radius-m must be > 0 m, got {radius_m:g}")
+        _compilation_cache()
+        try:
+            car = _load(vehicle, 0 if rigid else modes, form, param)
+            steer_deg = math.degrees(float(circle_steer(car, speed, radius_m, right=right)))
+        except (ParameterError, RuntimeError) as e:
+            fail(f"no steady state on the --radius-m {radius_m:g} m circle at {speed_kmh:g} km/h: {e}")
+    try:
+        m = make(speed, math.radians(steer_deg), decel_g, final_speed=final_speed, brake_start=brake_start_s,
+                 duration=duration)
+    except ParameterError as e:
+        fail(str(e))
+
+    def metrics(run, car):
+        out = {"steer_deg": steer_deg, "decel_target_g": decel_g, "final_speed_kmh": final_speed * 3.6}
+        try:
+            values = brake_in_turn_metrics(run.ts, run.channels, m.speed_target)
+        except ParameterError as e:
+            return out | {"metrics_error": str(e)}
+        before = np.interp([brake_start_s - 0.5, brake_start_s], np.asarray(run.ts),
+                           np.asarray(run.channels["yaw_rate"]))
+        steady = bool(abs(before[1] - before[0]) <= 0.01 * abs(before[1]))
+        return out | {k: float(jnp.asarray(v)) for k, v in values.items()} | {
+            "after_s": BRAKE_IN_TURN_AFTER, "steady_before_brake": steady}
+
+    from ..plots import BRAKE_IN_TURN_PANELS
+
+    _run("brake-in-turn", m, vehicle, modes, rigid, form, rtol, out_dir, as_json, quiet, metrics, settings=param,
+         panels=BRAKE_IN_TURN_PANELS)
+
+
 PreviewOpt = typer.Option(0.8, "--preview-s", help="driver's preview time, s (preview distance = speed x time)")
 LagOpt = typer.Option(0.1, "--lag-s", help="driver's steering lag, s")
 

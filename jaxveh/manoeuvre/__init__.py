@@ -16,11 +16,14 @@ from ._driver import (
     SweptSine as SweptSine,
     accelerate as accelerate,
     brake as brake,
+    brake_in_turn as brake_in_turn,
     kink_times as kink_times,
     step_steer as step_steer,
 )
 from ._export import run_dataset as run_dataset, write_netcdf as write_netcdf
 from ._metrics import (
+    BRAKE_IN_TURN_AFTER as BRAKE_IN_TURN_AFTER,
+    brake_in_turn_metrics as brake_in_turn_metrics,
     constant_radius_metrics as constant_radius_metrics,
     four_post_metrics as four_post_metrics,
     frequency_response as frequency_response,
@@ -67,6 +70,7 @@ from ._steady import (
     SkidPad as SkidPad,
     SteadyCornering as SteadyCornering,
     StraightTrim as StraightTrim,
+    circle_steer as circle_steer,
     skid_pad as skid_pad,
     skid_pad_core as skid_pad_core,
     steady_state as steady_state,

@@ -167,6 +167,35 @@ def brake(speed: float = 100 / 3.6, final_speed: float = 20 / 3.6, deceleration:
     return _straight_line(speed, final_speed, deceleration, start, rise, duration, settle)
 
 
+def brake_in_turn(speed: float = 80 / 3.6, angle: float = 0.0618, deceleration: float = 0.5,
+                  final_speed: float | None = None, steer_start: float = 0.5, rise: float = 0.2,
+                  brake_start: float = 3.0, brake_rise: float = 0.2, duration: float | None = None,
+                  settle: float = 0.5) -> Manoeuvre:
+    """Braking in a turn, open loop (after ISO 7975): from straight running at ``speed`` (m/s)
+    the steering wheel turns by ``angle`` (rad from straight running's, positive left; the
+    default 3.54 deg puts the shipped 6-mode car on a 100 m circle at 80 km/h, 0.5 g:
+    :func:`jaxveh.manoeuvre.circle_steer` gives it for any car and circle) from
+    ``steer_start`` over ``rise`` (s) and is then held; the car
+    settles on its circle and from ``brake_start`` (s) brakes at ``deceleration`` (g, > 0)
+    toward ``final_speed`` (m/s; default half of ``speed``), the rate rising over
+    ``brake_rise`` (s). ``duration`` (default: the speed change and ``settle`` s after).
+    :func:`jaxveh.manoeuvre.brake_in_turn_metrics` measures how the braking changes the
+    circle."""
+    final_speed = 0.5 * speed if final_speed is None else final_speed
+    if not 0.0 < float(final_speed) < float(speed):
+        raise ParameterError(f"final_speed = {float(final_speed):g} m/s must lie in (0, speed = {float(speed):g}) "
+                             "m/s (brake_in_turn; the tyre model needs rolling wheels)")
+    if not float(brake_start) >= float(steer_start) + float(rise):
+        raise ParameterError(f"brake_start = {float(brake_start):g} s must not come before the steering reaches "
+                             f"its angle at steer_start + rise = {float(steer_start) + float(rise):g} s")
+    change = SpeedChange(speed=speed, final_speed=final_speed, rate=deceleration * GRAVITY, start=brake_start,
+                         rise=brake_rise)
+    if duration is None:
+        duration = float(brake_start + change.change_time() + brake_rise + settle)
+    return Manoeuvre(steering=StepSteer(amplitude=angle, start=steer_start, rise=rise), speed=speed,
+                     duration=duration, speed_target=change)
+
+
 def kink_times(manoeuvre: Manoeuvre):
     """The times (s) where the manoeuvre's steering, road or speed target has a derivative
     jump (``kinks()`` of each; closed-loop drivers have none), as an array for Diffrax's

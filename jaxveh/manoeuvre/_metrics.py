@@ -1,8 +1,10 @@
-"""Handling metrics of a manoeuvre's channels (post-processing, NumPy)."""
+"""Handling metrics of a manoeuvre's channels (post-processing, NumPy; braking in a turn in
+JAX, differentiable)."""
 
+import jax.numpy as jnp
 import numpy as np
 
-from .._core import GRAVITY, ParameterError
+from .._core import GRAVITY, ParameterError, is_concrete
 from ..analytic._transient import _first_crossing
 from ..vehicle import SpeedChange
 from ._driver import StepSteer
@@ -267,4 +269,67 @@ def straight_line_metrics(ts, channels: dict, target: SpeedChange, settle_time: 
         "pitch_gradient_deg_per_g": float((pitch - pitch_straight)[hold].mean() / ax[hold].mean()),
         "front_load_share": float((fz[hold, :2].sum(axis=1) / fz[hold].sum(axis=1)).mean()),
         "front_torque_share": float((torque[hold, :2].sum(axis=1) / torque[hold].sum(axis=1)).mean()),
+    }
+
+
+#: Time (s) after the brake onset at which braking in a turn is measured (ISO 7975's t_n).
+BRAKE_IN_TURN_AFTER = 1.0
+
+
+def brake_in_turn_metrics(ts, channels: dict, target: SpeedChange, after: float = BRAKE_IN_TURN_AFTER) -> dict:
+    """How braking changes a steady circle (:func:`jaxveh.manoeuvre.brake_in_turn`), measured
+    ``after`` seconds past the brake onset ``t0 = target.start`` against the circle the car
+    was on at ``t0`` (radius ``R0`` = speed over yaw rate, centre beside the c.g. across its
+    velocity). Pure JAX (channels interpolated linearly between save times): differentiable
+    and vmappable; dict of scalars:
+
+    - ``initial_speed_kmh``, ``initial_radius_m`` (``|R0|``), ``initial_ay_g``,
+      ``initial_yaw_rate_deg_s`` (at ``t0``);
+    - ``yaw_rate_ratio``: yaw rate at ``t0 + after`` over its value at ``t0``;
+    - ``yaw_rate_ratio_to_reference``: yaw rate at ``t0 + after`` over the reference's, the
+      initial circle driven at the car's current speed (``v / R0``): above 1 the car turns
+      into the circle, below 1 it runs wide;
+    - ``heading_deviation_deg``: heading change since ``t0`` less the reference's (the
+      integral of ``v / R0``), positive into the turn;
+    - ``path_deviation_m``: the c.g.'s distance from the initial circle's centre less
+      ``|R0|`` (positive: outside the circle);
+    - ``sideslip_change_deg`` (into the turn positive), ``ay_g`` at ``t0 + after``;
+    - ``deceleration_g``: the mean deceleration over the interval (speed change over time).
+    """
+    ts = jnp.asarray(ts, jnp.float64)
+    t0 = jnp.asarray(target.start, jnp.float64)
+    t1 = t0 + after
+    if not after > 0.0:
+        raise ParameterError(f"after = {after!r} is out of range: allowed > 0 s")
+    if is_concrete(t0) and is_concrete(ts) and not (float(ts[0]) <= float(t0) and float(t1) <= float(ts[-1])):
+        raise ParameterError(f"the run must cover the brake onset and {after:g} s after it: saved over "
+                             f"[{float(ts[0]):g}, {float(ts[-1]):g}] s, brake onset at {float(t0):g} s")
+
+    def at(name, t):
+        return jnp.interp(t, ts, jnp.asarray(channels[name]))
+
+    heading = jnp.unwrap(jnp.radians(jnp.asarray(channels["heading"])))
+    yaw0, yaw1 = jnp.radians(at("yaw_rate", t0)), jnp.radians(at("yaw_rate", t1))
+    v0, v1 = at("speed", t0), at("speed", t1)
+    radius = v0 / yaw0  # signed: positive turning left
+    turn = jnp.sign(yaw0)
+    grid = jnp.linspace(t0, t1, 201)
+    speed_on_grid = at("speed", grid)
+    travelled = jnp.sum(0.5 * (speed_on_grid[1:] + speed_on_grid[:-1]) * jnp.diff(grid))
+    course = jnp.interp(t0, ts, heading) + jnp.radians(at("sideslip", t0))
+    centre = jnp.stack([at("x", t0) - radius * jnp.sin(course), at("y", t0) + radius * jnp.cos(course)])
+    position = jnp.stack([at("x", t1), at("y", t1)])
+    turned = jnp.interp(t1, ts, heading) - jnp.interp(t0, ts, heading)
+    return {
+        "initial_speed_kmh": 3.6 * v0,
+        "initial_radius_m": jnp.abs(radius),
+        "initial_ay_g": at("ay", t0),
+        "initial_yaw_rate_deg_s": jnp.degrees(yaw0),
+        "yaw_rate_ratio": yaw1 / yaw0,
+        "yaw_rate_ratio_to_reference": yaw1 / (v1 / radius),
+        "heading_deviation_deg": turn * jnp.degrees(turned - travelled / radius),
+        "path_deviation_m": jnp.linalg.norm(position - centre) - jnp.abs(radius),
+        "sideslip_change_deg": turn * (at("sideslip", t1) - at("sideslip", t0)),
+        "ay_g": at("ay", t1),
+        "deceleration_g": (v0 - v1) / after / GRAVITY,
     }

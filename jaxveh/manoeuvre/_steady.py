@@ -279,6 +279,20 @@ def steady_state(car, *, speed=None, radius=None, ay=None, yaw_rate=None, steer=
     return result
 
 
+def circle_steer(car, speed, radius, right: bool = False, max_steps: int = 64):
+    """The steering-wheel angle (rad, from straight running's, negative right) an open-loop
+    run of the fast car holds to settle on a circle of ``radius`` (m, the c.g.'s path) at
+    ``speed`` (m/s): the steady states at yaw rate ``+-speed / radius`` and 0
+    (:func:`steady_state`; a manoeuvre's steering law is measured from straight running's
+    rack, which the tyres' asymmetry moves off centre)."""
+    if not float(radius) > 0.0:
+        raise ParameterError(f"radius = {radius!r} is out of range: allowed > 0 m")
+    yaw_rate = (-1.0 if right else 1.0) * float(speed) / float(radius)
+    straight = steady_state(car, speed=speed, yaw_rate=0.0, max_steps=max_steps)
+    circle = steady_state(car, speed=speed, yaw_rate=yaw_rate, max_steps=max_steps)
+    return (straight.rack - circle.rack) / car.params.rack_ratio
+
+
 class SkidPad(eqx.Module):
     """Steady states on a circle of ``radius`` (m) at the lateral accelerations ``ay``
     (m/s^2, the targets): ``states`` (a :class:`SteadyCornering` with a leading axis),

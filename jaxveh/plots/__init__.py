@@ -19,6 +19,7 @@ from ._kinematics import (
     plot_simplifications as plot_simplifications,
 )
 from ._manoeuvres import (
+    BRAKE_IN_TURN_PANELS as BRAKE_IN_TURN_PANELS,
     STRAIGHT_LINE_PANELS as STRAIGHT_LINE_PANELS,
     plot_four_post as plot_four_post,
     plot_frequency_response as plot_frequency_response,

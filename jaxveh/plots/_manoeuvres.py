@@ -22,6 +22,15 @@ STRAIGHT_LINE_PANELS = (
     ("wheel_torque", "wheel torque [N m] (brake -)", "corners"),
     ("modes", "modal coordinates [-]", "all"),
 )
+#: Panels of braking in a turn.
+BRAKE_IN_TURN_PANELS = (
+    ("yaw_rate", "yaw rate [deg/s]", None),
+    ("ay", "ay [g]", None),
+    ("ax", "ax [g]", None),
+    ("sideslip", "sideslip [deg]", None),
+    ("fz", "tyre load Fz [N]", "corners"),
+    ("wheel_torque", "wheel torque [N m] (brake -)", "corners"),
+)
 _CORNERS = ("FL", "FR", "RL", "RR")
 
 
