@@ -296,14 +296,16 @@ def brake_in_turn_metrics(ts, channels: dict, target: SpeedChange, after: float 
     - ``sideslip_change_deg`` (into the turn positive), ``ay_g`` at ``t0 + after``;
     - ``deceleration_g``: the mean deceleration over the interval (speed change over time).
     """
+    if not after > 0.0:
+        raise ParameterError(f"after = {after!r} is out of range: allowed > 0 s")
+    if is_concrete(ts) and is_concrete(target.start):  # checked in NumPy (also inside a trace)
+        saved, onset = np.asarray(ts, float), float(target.start)
+        if not saved[0] <= onset and onset + after <= saved[-1]:
+            raise ParameterError(f"the run must cover the brake onset and {after:g} s after it: saved over "
+                                 f"[{saved[0]:g}, {saved[-1]:g}] s, brake onset at {onset:g} s")
     ts = jnp.asarray(ts, jnp.float64)
     t0 = jnp.asarray(target.start, jnp.float64)
     t1 = t0 + after
-    if not after > 0.0:
-        raise ParameterError(f"after = {after!r} is out of range: allowed > 0 s")
-    if is_concrete(t0) and is_concrete(ts) and not (float(ts[0]) <= float(t0) and float(t1) <= float(ts[-1])):
-        raise ParameterError(f"the run must cover the brake onset and {after:g} s after it: saved over "
-                             f"[{float(ts[0]):g}, {float(ts[-1]):g}] s, brake onset at {float(t0):g} s")
 
     def at(name, t):
         return jnp.interp(t, ts, jnp.asarray(channels[name]))
