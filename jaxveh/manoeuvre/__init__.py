@@ -30,6 +30,8 @@ from ._metrics import (
     lane_change_metrics as lane_change_metrics,
     ramp_steer_metrics as ramp_steer_metrics,
     step_steer_metrics as step_steer_metrics,
+    straight_line_hold as straight_line_hold,
+    straight_line_means as straight_line_means,
     straight_line_metrics as straight_line_metrics,
 )
 from ._paths import (

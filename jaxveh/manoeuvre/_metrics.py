@@ -239,11 +239,7 @@ def straight_line_metrics(ts, channels: dict, target: SpeedChange, settle_time: 
     start, rise, rate = float(target.start), float(target.rise), float(target.rate)
     v0, v1 = float(target.speed), float(target.final_speed)
     sign = 1.0 if v1 > v0 else -1.0
-    hold = (ts >= start + rise + settle_time) & (ts <= start + abs(v1 - v0) / rate)
-    if hold.sum() < 3:
-        raise ParameterError(f"the hold at the full rate is too short for the metrics: fewer than 3 save times "
-                             f"between {start + rise + settle_time:g} s and {start + abs(v1 - v0) / rate:g} s "
-                             "(a larger speed change, a lower rate, more points or a shorter settle_time)")
+    hold = straight_line_hold(ts, start, rise, abs(v1 - v0) / rate, settle_time)
     speed, ax = np.asarray(channels["speed"]), np.asarray(channels["ax"])
     reached = sign * (speed - v1) >= -0.01 * abs(v1 - v0)
     after = ts >= start
@@ -253,22 +249,49 @@ def straight_line_metrics(ts, channels: dict, target: SpeedChange, settle_time: 
     end = int(np.argmax(reached & after))
     window = (ts >= start) & (ts <= ts[end])
     distance = float(np.sum(0.5 * (speed[window][1:] + speed[window][:-1]) * np.diff(ts[window])))
-    fz, torque = np.asarray(channels["fz"]), np.asarray(channels["wheel_torque"])
-    # straight running's own pitch at each speed (aero loads grow with v^2): linear in v^2
-    # between the start and the settled end of the run
-    pitch = np.asarray(channels["pitch"])
-    pitch_straight = pitch[0] + (pitch[-1] - pitch[0]) * (speed ** 2 - speed[0] ** 2) / (speed[-1] ** 2 - speed[0] ** 2)
+    means = {k: float(v) for k, v in straight_line_means(channels, hold).items()}
     return {
         "ax_target_g": sign * rate / GRAVITY,
-        "ax_mean_g": float(ax[hold].mean()),
-        "target_followed": bool(abs(ax[hold].mean() - sign * rate / GRAVITY) <= FOLLOWED * rate / GRAVITY),
+        "ax_mean_g": means["ax_mean_g"],
+        "target_followed": bool(abs(means["ax_mean_g"] - sign * rate / GRAVITY) <= FOLLOWED * rate / GRAVITY),
         "peak_ax_g": float(sign * np.max(sign * ax)),
         "time_to_final_speed_s": float(ts[end] - start),
         "distance_m": distance,
-        "pitch_mean_deg": float(pitch[hold].mean()),
-        "pitch_gradient_deg_per_g": float((pitch - pitch_straight)[hold].mean() / ax[hold].mean()),
-        "front_load_share": float((fz[hold, :2].sum(axis=1) / fz[hold].sum(axis=1)).mean()),
-        "front_torque_share": float((torque[hold, :2].sum(axis=1) / torque[hold].sum(axis=1)).mean()),
+    } | {k: means[k] for k in ("pitch_mean_deg", "pitch_gradient_deg_per_g", "front_load_share",
+                               "front_torque_share")}
+
+
+def straight_line_hold(ts, start: float, rise: float, change_time: float, settle_time: float):
+    """The hold window of :func:`straight_line_metrics` (a NumPy mask of the save times ``ts``,
+    s): from ``settle_time`` after the target's rate is reached (``start + rise``) to the end
+    of the hold (``start + change_time``); a clear error when it holds fewer than 3."""
+    ts = np.asarray(ts, float)
+    hold = (ts >= start + rise + settle_time) & (ts <= start + change_time)
+    if hold.sum() < 3:
+        raise ParameterError(f"the hold at the full rate is too short for the metrics: fewer than 3 save times "
+                             f"between {start + rise + settle_time:g} s and {start + change_time:g} s "
+                             "(a larger speed change, a lower rate, more points or a shorter settle_time)")
+    return hold
+
+
+def straight_line_means(channels: dict, hold) -> dict:
+    """The hold window's means of :func:`straight_line_metrics` (``hold``: a NumPy mask of the
+    save times): ``ax_mean_g``, ``pitch_mean_deg``, ``pitch_gradient_deg_per_g``,
+    ``front_load_share``, ``front_torque_share``. Pure JAX: differentiable (the optimiser's
+    braking objectives)."""
+    hold = np.asarray(hold, bool)
+    speed, ax, pitch = (jnp.asarray(channels[k]) for k in ("speed", "ax", "pitch"))
+    fz, torque = jnp.asarray(channels["fz"]), jnp.asarray(channels["wheel_torque"])
+    # straight running's own pitch at each speed (aero loads grow with v^2): linear in v^2
+    # between the start and the settled end of the run
+    pitch_straight = pitch[0] + (pitch[-1] - pitch[0]) * (speed ** 2 - speed[0] ** 2) / (speed[-1] ** 2 - speed[0] ** 2)
+    ax_mean = jnp.mean(ax[hold])
+    return {
+        "ax_mean_g": ax_mean,
+        "pitch_mean_deg": jnp.mean(pitch[hold]),
+        "pitch_gradient_deg_per_g": jnp.mean((pitch - pitch_straight)[hold]) / ax_mean,
+        "front_load_share": jnp.mean(fz[hold, :2].sum(axis=1) / fz[hold].sum(axis=1)),
+        "front_torque_share": jnp.mean(torque[hold, :2].sum(axis=1) / torque[hold].sum(axis=1)),
     }
 
 
