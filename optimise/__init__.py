@@ -2,6 +2,13 @@
 constraints, solved with Optax (augmented Lagrangian around a gradient optimiser); study
 files and sensitivity maps at scale (``sweep``: chunked vmap, checkpoints, Ray)."""
 
+from ._braking import (
+    BRAKE_IN_TURN_SETTINGS as BRAKE_IN_TURN_SETTINGS,
+    BRAKING_SETTINGS as BRAKING_SETTINGS,
+    BrakingMetrics as BrakingMetrics,
+    brake_in_turn_objectives as brake_in_turn_objectives,
+    braking_metrics as braking_metrics,
+)
 from ._car_file import (
     CAR_FILE_KEYS as CAR_FILE_KEYS,
     changed_car_values as changed_car_values,
@@ -23,6 +30,12 @@ from ._objectives import (
     Objective as Objective,
     ObjectiveSpec as ObjectiveSpec,
     arb_rates_for_lambda as arb_rates_for_lambda,
+    brake_in_turn_heading_deviation as brake_in_turn_heading_deviation,
+    brake_in_turn_path_deviation as brake_in_turn_path_deviation,
+    brake_in_turn_yaw_ratio as brake_in_turn_yaw_ratio,
+    braking_deceleration as braking_deceleration,
+    braking_front_load_share as braking_front_load_share,
+    braking_pitch_gradient as braking_pitch_gradient,
     bump_steer as bump_steer,
     camber_gain as camber_gain,
     camber_gradient as camber_gradient,

@@ -23,6 +23,9 @@ Each objective wraps what jaxveh computes; none re-derives the physics:
   linearisation (:mod:`optimise._response`);
 - the yaw-rate response of a step steer of any size from the fast car's time run
   (:mod:`optimise._step_steer`; ``step_steer_*``);
+- straight-line braking (deceleration, dive, front load share) and braking in a turn (yaw
+  rate, heading and path against the initial circle) from the fast car's time runs
+  (:mod:`optimise._braking`; ``braking_*``, ``brake_in_turn_*``);
 - bump steer and camber gain from each corner's kinematics at the design pose
   (:func:`suspension_kinematics`: the fast car's exact corner solve, differentiated along the
   wheel travel);
@@ -60,6 +63,7 @@ from jaxveh.analysis import (
 from jaxveh.manoeuvre import skid_pad_core, straight_trim
 from jaxveh.vehicle import CORNERS, car_rates, corner_poses, fast_model, installation_ratios
 
+from ._braking import BRAKE_IN_TURN_SETTINGS, BRAKING_SETTINGS, brake_in_turn_objectives, braking_metrics
 from ._response import (
     linear_io,
     preview_distance_of,
@@ -539,6 +543,46 @@ def preview_length(car, speed_kmh=PREVIEW_SPEED_KMH, n_preview=N_PREVIEW):
 # ---- the frame --------------------------------------------------------------------------------
 
 
+def braking_deceleration(car, reverse=False, **settings):
+    """Mean deceleration (g) over the hold of straight-line braking at ``decel_g``
+    (:func:`optimise._braking.braking_metrics`; ``settings``: ``speed_kmh``,
+    ``final_speed_kmh``, ``decel_g``, ``settle_s``, ``rtol``): the target's when the car can
+    give it, else the most its tyres and brake balance give."""
+    return braking_metrics(car, **settings, reverse=reverse).deceleration
+
+
+def braking_pitch_gradient(car, reverse=False, **settings):
+    """Pitch per g of deceleration (deg/g; negative: the nose dives) over the braking hold (as
+    :func:`braking_deceleration`)."""
+    return braking_metrics(car, **settings, reverse=reverse).pitch_gradient
+
+
+def braking_front_load_share(car, reverse=False, **settings):
+    """The front axle's share of the tyre loads over the braking hold (as
+    :func:`braking_deceleration`)."""
+    return braking_metrics(car, **settings, reverse=reverse).front_load_share
+
+
+def brake_in_turn_yaw_ratio(car, reverse=False, **settings):
+    """Braking in a turn: yaw rate ``after_s`` into the braking over the initial circle's at
+    the current speed (1: the car stays on its circle; above: it turns in)
+    (:func:`optimise._braking.brake_in_turn_objectives`; ``settings``: ``speed_kmh``,
+    ``radius_m``, ``decel_g``, ``after_s``, ``rtol``)."""
+    return brake_in_turn_objectives(car, **settings, reverse=reverse)["yaw_rate_ratio_to_reference"]
+
+
+def brake_in_turn_heading_deviation(car, reverse=False, **settings):
+    """Braking in a turn: heading deviation (deg, into the turn positive) from the initial
+    circle ``after_s`` into the braking (as :func:`brake_in_turn_yaw_ratio`)."""
+    return brake_in_turn_objectives(car, **settings, reverse=reverse)["heading_deviation_deg"]
+
+
+def brake_in_turn_path_deviation(car, reverse=False, **settings):
+    """Braking in a turn: the c.g.'s distance outside the initial circle (m; negative inside)
+    ``after_s`` into the braking (as :func:`brake_in_turn_yaw_ratio`)."""
+    return brake_in_turn_objectives(car, **settings, reverse=reverse)["path_deviation_m"]
+
+
 def chassis_mass(frame: fe.Frame):
     """Mass of the chassis frame (kg), :func:`jaxveh.fe.frame_mass`."""
     return fe.frame_mass(frame)
@@ -575,6 +619,8 @@ SOURCES = {
     "road_response": Source(road_response, {"speed_kmh": FOUR_POST_SPEED_KMH}),
     "preview": Source(preview_length, {"speed_kmh": PREVIEW_SPEED_KMH, "n_preview": N_PREVIEW}),
     "step_steer": Source(step_steer_metrics, STEP_STEER_SETTINGS, time_run=True),
+    "braking": Source(braking_metrics, BRAKING_SETTINGS, time_run=True),
+    "brake_in_turn": Source(brake_in_turn_objectives, BRAKE_IN_TURN_SETTINGS, time_run=True),
     "skid_pad": Source(skid_pad_point, {"ay_g": DEFAULT_AY_G, "radius": SKID_PAD_RADIUS}),
     "kinematics": Source(suspension_kinematics, {}),
     "load_transfer": Source(load_transfer_point, {"ay_g": tuple(LOW_AY_PAIR_G), "radius": SKID_PAD_RADIUS}),
@@ -658,6 +704,23 @@ OBJECTIVES = {
     "step_steer_steady_yaw_rate": Objective(step_steer_steady_yaw_rate, "deg/s", "steady yaw rate after a step "
                                             "steer of any size, the fast car's time run", "step_steer",
                                             lambda m: m.steady),
+    "braking_deceleration": Objective(braking_deceleration, "g", "mean deceleration over the hold of straight-line "
+                                      "braking at decel_g (the most the car gives when the target is beyond it), "
+                                      "the fast car's time run", "braking", lambda m: m.deceleration),
+    "braking_pitch_gradient": Objective(braking_pitch_gradient, "deg/g", "pitch per g of deceleration in "
+                                        "straight-line braking (negative: dive)", "braking",
+                                        lambda m: m.pitch_gradient),
+    "braking_front_load_share": Objective(braking_front_load_share, "1", "front axle's share of the tyre loads in "
+                                          "straight-line braking", "braking", lambda m: m.front_load_share),
+    "brake_in_turn_yaw_ratio": Objective(brake_in_turn_yaw_ratio, "1", "braking in a turn: yaw rate after_s into "
+                                         "the braking over the initial circle's at the current speed (above 1: "
+                                         "turns in)", "brake_in_turn", lambda m: m["yaw_rate_ratio_to_reference"]),
+    "brake_in_turn_heading_deviation": Objective(brake_in_turn_heading_deviation, "deg", "braking in a turn: "
+                                                 "heading deviation from the initial circle (into the turn "
+                                                 "positive)", "brake_in_turn", lambda m: m["heading_deviation_deg"]),
+    "brake_in_turn_path_deviation": Objective(brake_in_turn_path_deviation, "m", "braking in a turn: distance "
+                                              "outside the initial circle (negative inside)", "brake_in_turn",
+                                              lambda m: m["path_deviation_m"]),
     "rms_fz_variation": Objective(rms_fz_variation, "N", "RMS contact-patch load variation of one tyre over a "
                                   "four-post sine sweep (quasi-stationary, linearised car)", "road_response",
                                   _rms_fz, SWEEP_OPTIONS),

@@ -73,6 +73,7 @@ from ._steady import (
     SteadyCornering as SteadyCornering,
     StraightTrim as StraightTrim,
     circle_steer as circle_steer,
+    circle_steer_core as circle_steer_core,
     skid_pad as skid_pad,
     skid_pad_core as skid_pad_core,
     steady_state as steady_state,

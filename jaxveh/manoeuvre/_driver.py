@@ -182,10 +182,11 @@ def brake_in_turn(speed: float = 80 / 3.6, angle: float = 0.0618, deceleration: 
     :func:`jaxveh.manoeuvre.brake_in_turn_metrics` measures how the braking changes the
     circle."""
     final_speed = 0.5 * speed if final_speed is None else final_speed
-    if not 0.0 < float(final_speed) < float(speed):
+    if all(map(is_concrete, (speed, final_speed))) and not 0.0 < float(final_speed) < float(speed):
         raise ParameterError(f"final_speed = {float(final_speed):g} m/s must lie in (0, speed = {float(speed):g}) "
                              "m/s (brake_in_turn; the tyre model needs rolling wheels)")
-    if not float(brake_start) >= float(steer_start) + float(rise):
+    if (all(map(is_concrete, (brake_start, steer_start, rise)))
+            and not float(brake_start) >= float(steer_start) + float(rise)):
         raise ParameterError(f"brake_start = {float(brake_start):g} s must not come before the steering reaches "
                              f"its angle at steer_start + rise = {float(steer_start) + float(rise):g} s")
     change = SpeedChange(speed=speed, final_speed=final_speed, rate=deceleration * GRAVITY, start=brake_start,

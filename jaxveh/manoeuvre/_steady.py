@@ -279,6 +279,15 @@ def steady_state(car, *, speed=None, radius=None, ay=None, yaw_rate=None, steer=
     return result
 
 
+def circle_steer_core(car, speed, yaw_rate, straight_rack, max_steps: int = 64):
+    """``(steer, ok)``: the pure core of :func:`circle_steer` (jit, vmap, grad): the
+    steering-wheel angle (rad) from straight running's (its ``straight_rack``, m) to the
+    steady state at ``speed`` (m/s) and ``yaw_rate`` (rad/s), and whether Newton converged."""
+    circle, _ = steady_state_core(car, condition_kinds(("speed", "yaw_rate")), (speed, yaw_rate),
+                                  max_steps=max_steps)
+    return (straight_rack - circle.rack) / car.params.rack_ratio, circle.ok
+
+
 def circle_steer(car, speed, radius, right: bool = False, max_steps: int = 64):
     """The steering-wheel angle (rad, from straight running's, negative right) an open-loop
     run of the fast car holds to settle on a circle of ``radius`` (m, the c.g.'s path) at
