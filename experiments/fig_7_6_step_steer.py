@@ -24,7 +24,7 @@ def main():
         ch = {k: np.asarray(v) for k, v in run.channels.items()}
         report[label] = step_steer_metrics(run.ts, ch, m.steering) | {
             "front_road_wheel_angle_deg": float(np.mean(ch["road_wheel_angle"][-1, :2])),
-            "steps": int(run.steps), "wall_s_with_compilation": run.wall_s}
+            "steps": int(run.steps), "wall_s": run.wall_s}
         histories[label] = {"t_s": np.asarray(run.ts) - START, **ch}
     analytic = step_steer_report(load_analytic_vehicle(), speed_kmh=90.0, steer_deg=1.5, rise_s=RISE, t_end=4.0)
     report["chapter_3"] = {k: {key: analytic[k][key] for key in ("yaw_rate_response_time_s", "yaw_rate_overshoot_pct",

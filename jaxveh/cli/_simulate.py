@@ -138,7 +138,7 @@ def _run(name: str, manoeuvre, vehicle, modes, rigid, form, rtol, out_dir, as_js
     if as_json:
         emit_json(report)
         return
-    typer.echo(f"{report['title']}: {report['wall_time_s']:.2f} s (compilation included on a first run), "
+    typer.echo(f"{report['title']}: {report['wall_time_s']:.2f} s (after compilation), "
                f"{report['steps']} steps" + (f"; wrote {out_dir}" if out_dir else ""))
     for key, value in report.items():
         if isinstance(value, bool):

@@ -78,7 +78,8 @@ class CarRun(eqx.Module):
     leading time axis, units in ``units``), the ``form`` and ``solver`` that ran, the Diffrax
     step counts, ``status`` (0 completed, 1 stopped by an event, 2 solver failure), ``stop_reason``
     ("completed", the event or the failure and its time, or "traced" under ``jit``),
-    ``wall_s`` (s, after compilation when the caller compiled first; NaN under ``jit``) and
+    ``wall_s`` (s: the compiled programs' runs, trim included, after their compilation; NaN
+    under ``jit``) and
     ``valid`` (per save time: reached before the stop; later values hold the last reached
     one, never inf or NaN)."""
 
@@ -411,21 +412,23 @@ def _run_programs(car, manoeuvre, ts, trim, run_kwargs: dict):
     return _compiled_fast_channels(car, manoeuvre, trim, ts, sol.states, sol.model), sol.stats, sol.status
 
 
-def _compile_programs(car, speed, manoeuvre, ts, run_kwargs: dict) -> None:
-    """Compile :func:`simulate`'s programs (the trim's, and the run's: on the fast car the
-    solve's and the channels') at once, once per signature: this thread traces each in turn
-    for placeholders of its inputs' shapes (``eqx.filter_eval_shape`` of the program before it)
-    and two more compile them as they come (XLA releases the Python lock while it compiles,
-    so they use two cores). JAX's cache then serves the calls (docs/manoeuvre.md,
-    "Compilation")."""
-    key = _signature(car, manoeuvre, ts, run_kwargs)
+def _compile_programs(car, speed, manoeuvre, ts, run_kwargs: dict, trim=None) -> None:
+    """Compile :func:`simulate`'s programs (the trim's, unless ``trim`` is given, and the
+    run's: on the fast car the solve's and the channels') at once, once per signature: this
+    thread traces each in turn for placeholders of its inputs' shapes
+    (``eqx.filter_eval_shape`` of the program before it) and two more compile them as they
+    come (XLA releases the Python lock while it compiles, so they use two cores). JAX's cache
+    then serves the calls (docs/manoeuvre.md, "Compilation")."""
+    key = _signature(car, manoeuvre, ts, run_kwargs, trim)
     if key is None or key in _compiled_sets:
         return
     form = run_kwargs["form"]
     trim_program, speed = _trim_program(form), jnp.asarray(speed, jnp.float64)
     with ThreadPoolExecutor(2) as pool:
-        trim = _placeholder(eqx.filter_eval_shape(trim_program, car, speed))
-        jobs = [pool.submit(trim_program.lower(car, speed).compile)]
+        jobs = []
+        if trim is None:
+            trim = _placeholder(eqx.filter_eval_shape(trim_program, car, speed))
+            jobs.append(pool.submit(trim_program.lower(car, speed).compile))
         if form == "library":
             jobs.append(pool.submit(_compiled.lower(car, manoeuvre, ts, trim=trim, **run_kwargs).compile))
         else:
@@ -499,13 +502,13 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
     _check_linearisations(linearisations)
     ts = save_times(manoeuvre, points)
     check_car(car)  # here, so that the programs need no run-time checks (the disk cache keeps them)
-    start = time.perf_counter()
     run_kwargs = dict(form=form, solver=solver, rtol=jnp.asarray(rtol, jnp.float64),
                       atol=jnp.asarray(atol, jnp.float64), max_steps=max_steps, freeze_steps=freeze_steps,
                       linearisations=linearisations)  # tolerances as arrays: one compilation serves all
     with run_time_checks_off():
+        _compile_programs(car, manoeuvre.speed, manoeuvre, ts, run_kwargs, trim)
+        start = time.perf_counter()  # the wall time: the programs' runs, after their compilation
         if trim is None:
-            _compile_programs(car, manoeuvre.speed, manoeuvre, ts, run_kwargs)
             trim, trim_ok = _compiled_trim(car, manoeuvre.speed, form)
         else:
             trim_ok = _check_trim(trim, form)
