@@ -177,6 +177,17 @@ def test_cli_brake_in_turn_json(tmp_path):
     assert "yaw_rate_deg/s" in (tmp_path / "brake_in_turn.csv").read_text().splitlines()[0].split(",")
 
 
+def test_cli_names_a_spin_instead_of_measuring_it():
+    """Rear brakes locking at 2 g spin the car within the second the metrics need: the run
+    stops on the event and the JSON says why there are no metrics."""
+    result = CliRunner().invoke(app, ["simulate", "brake-in-turn", "--rigid", "--json", "--decel-g", "2",
+                                      "--param", "pid.brake_front_share=0.2"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.output)
+    assert out["stop_reason"].startswith("spin") and "no metrics" in out["metrics_error"]
+    assert "heading_deviation_deg" not in out
+
+
 @pytest.mark.parametrize("args, match", [
     (["--decel-g", "0"], "--decel-g"),
     (["--final-speed-kmh", "90"], "--final-speed-kmh"),

@@ -398,6 +398,10 @@ def brake_in_turn(
 
     def metrics(run, car):
         out = {"steer_deg": steer_deg, "decel_target_g": decel_g, "final_speed_kmh": final_speed * 3.6}
+        reached = np.asarray(run.ts)[np.asarray(run.valid)]
+        if not reached.size or reached[-1] < brake_start_s + BRAKE_IN_TURN_AFTER:
+            return out | {"metrics_error": f"the run stopped ({run.stop_reason}) before {BRAKE_IN_TURN_AFTER:g} s "
+                                           "into the braking: no metrics"}
         try:
             values = brake_in_turn_metrics(run.ts, run.channels, m.speed_target)
         except ParameterError as e:
