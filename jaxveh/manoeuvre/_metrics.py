@@ -323,7 +323,7 @@ def brake_in_turn_metrics(ts, channels: dict, target: SpeedChange, after: float 
         raise ParameterError(f"after = {after!r} is out of range: allowed > 0 s")
     if is_concrete(ts) and is_concrete(target.start):  # checked in NumPy (also inside a trace)
         saved, onset = np.asarray(ts, float), float(target.start)
-        if not saved[0] <= onset and onset + after <= saved[-1]:
+        if not (saved[0] <= onset and onset + after <= saved[-1]):
             raise ParameterError(f"the run must cover the brake onset and {after:g} s after it: saved over "
                                  f"[{saved[0]:g}, {saved[-1]:g}] s, brake onset at {onset:g} s")
     ts = jnp.asarray(ts, jnp.float64)
