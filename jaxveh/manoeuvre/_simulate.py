@@ -506,12 +506,11 @@ def simulate(car, manoeuvre: Manoeuvre, *, form: str | None = None, points: int 
                       atol=jnp.asarray(atol, jnp.float64), max_steps=max_steps, freeze_steps=freeze_steps,
                       linearisations=linearisations)  # tolerances as arrays: one compilation serves all
     with run_time_checks_off():
+        trim_ok = None if trim is None else _check_trim(trim, form)  # a given trim checked before compiling
         _compile_programs(car, manoeuvre.speed, manoeuvre, ts, run_kwargs, trim)
         start = time.perf_counter()  # the wall time: the programs' runs, after their compilation
         if trim is None:
             trim, trim_ok = _compiled_trim(car, manoeuvre.speed, form)
-        else:
-            trim_ok = _check_trim(trim, form)
         if not bool(trim_ok):
             raise SetupError(f"the {form} car's straight running at {float(manoeuvre.speed):g} m/s was not found "
                              "(the powertrain's torque against drag and rolling resistance?)")
