@@ -58,7 +58,7 @@ MODULE_SECONDS = {
     "test_manoeuvre.py": 1800,
     "test_vehicle_car.py": 1398,
     "test_optimise_car.py": 801,
-    "test_optimise_braking.py": 700,
+    "test_optimise_braking.py": 450,
     "test_analysis_load_transfer.py": 693,
     "test_vehicle_rigs.py": 534,
     "test_manoeuvre_steady.py": 477,
