@@ -72,7 +72,7 @@ MODULE_SECONDS = {
     "test_multibody_flexible.py": 281,
     "test_multibody_imex.py": 262,
     "test_manoeuvre_straight_line.py": 240,
-    "test_manoeuvre_brake_in_turn.py": 240,
+    "test_manoeuvre_brake_in_turn.py": 150,
     "test_manoeuvre_frequency.py": 221,
     "test_vehicle_corner.py": 125,
     "test_optimise_kinematics.py": 200,
