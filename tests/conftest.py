@@ -22,6 +22,7 @@ traced without them (``jaxveh._core.run_time_checks_off``), so they are.
 import ctypes
 import ctypes.util
 import gc
+import logging
 import os
 import signal
 import sys
@@ -255,13 +256,30 @@ _COMPILE_LOG = os.environ.get("JAXVEH_COMPILE_LOG")
 if _COMPILE_LOG:
 
     def _log_compile_phase(event: str, duration: float, **kwargs):
-        """Append ``test, phase, seconds`` for each tracing, lowering, XLA compilation and
-        disk-cache retrieval (tab-separated) to the file ``$JAXVEH_COMPILE_LOG``."""
+        """Append ``test, phase, seconds, function`` for each tracing, lowering, XLA
+        compilation and disk-cache retrieval (tab-separated) to ``$JAXVEH_COMPILE_LOG``."""
         if event.endswith("_duration") or "compilation_cache" in event:
             with open(_COMPILE_LOG, "a") as f:
-                f.write(f"{_current_test[0]}\t{event.rsplit('/', 1)[-1]}\t{duration:.3f}\n")
+                f.write(f"{_current_test[0]}\t{event.rsplit('/', 1)[-1]}\t{duration:.3f}"
+                        f"\t{kwargs.get('fun_name', '')}\n")
+
+    class _CacheLookups(logging.Handler):
+        """Append ``test, cache_hit|cache_miss, 0, program, key`` for each lookup in the
+        persistent cache: the same key missed in two tests is a program compiled twice."""
+
+        def emit(self, record):
+            message = record.getMessage()
+            outcome = ("cache_miss" if message.startswith("PERSISTENT COMPILATION CACHE MISS")
+                       else "cache_hit" if message.startswith("Persistent compilation cache hit") else None)
+            if outcome is not None:
+                program, key = record.args
+                with open(_COMPILE_LOG, "a") as f:
+                    f.write(f"{_current_test[0]}\t{outcome}\t0\t{program}\t{key}\n")
 
     monitoring.register_event_duration_secs_listener(_log_compile_phase)
+    _compiler_logger = logging.getLogger("jax._src.compiler")
+    _compiler_logger.setLevel(logging.DEBUG)
+    _compiler_logger.addHandler(_CacheLookups(level=logging.DEBUG))
 
 
 _MEMORY_LOG = os.environ.get("JAXVEH_MEMORY_LOG")
