@@ -12,7 +12,15 @@ full evaluation (``q_dot``, ``u_dot``, ``aux_dot``).
 ``jaxveh`` function on their trace stack (from the stack-frame tables XLA prints with the
 compiled program) and prints the ``N`` functions with the most: where to cut operations.
 
-    .venv/bin/python experiments/profile_fast_car.py [--json results/profile_fast_car.json] [--by-source 30]
+``--reverse`` profiles each piece's vector-Jacobian product instead, its forward time beside
+(``jax.vjp`` with respect to the piece's array arguments, applied to a cotangent of ones:
+the linearisation and the transpose, what a reverse pass runs per evaluation); the full
+evaluation's product is also taken with respect to the fast model (the car's parameters,
+as the replayed solve's reverse pass differentiates them), and ``--by-source`` then
+attributes that program's operations. The car is traced with its run-time checks off, as
+``simulate`` traces it.
+
+    .venv/bin/python experiments/profile_fast_car.py [--json results/profile_fast_car.json] [--by-source 30] [--reverse]
 
 ``--json`` writes ``{"pieces": [...], "full_by_source": {...} or null}``.
 """
@@ -29,6 +37,7 @@ import jax.numpy as jnp
 
 import jaxveh  # noqa: F401  (float64)
 import jaxveh.multibody as mb
+from jaxveh._core import run_time_checks_off
 from jaxveh.vehicle import (
     ConstantSpeed,
     _corner_kinematics as ck,
@@ -162,10 +171,46 @@ def pieces():
     yield "four-corner suspension", lambda kin: fs.suspension_forces(four, kin), (kin,)
     yield "full", lambda q, u, aux: _outputs(fast.fast_dynamics(car, model, q, u, aux, 0.3, inputs, elements)), (
         q, u, aux)
+    yield "full with the model", lambda q, u, aux, model: _outputs(
+        fast.fast_dynamics(car, model, q, u, aux, 0.3, inputs, elements)), (q, u, aux, model)
 
 
 def _outputs(d):
     return d.q_dot, d.u_dot, d.aux_dot
+
+
+def reverse(f):
+    """``f``'s vector-Jacobian product with respect to its arguments' floating leaves, applied
+    to a cotangent of ones (a function of the same arguments)."""
+
+    def product(*a):
+        out, pull = jax.vjp(f, *a)
+        return pull(jax.tree.map(jnp.ones_like, out))
+
+    return product
+
+
+def profile(args):
+    """Rows ``{piece, ops, us, forward_us, by_kind}`` (printed as they come) and the full
+    evaluation's (or product's, ``--reverse``) operations by source (or None)."""
+    rows, sources = [], None
+    by_source_of = "full with the model" if args.reverse else "full"
+    print(f"{'piece':28s} {'ops':>5s} {'us':>8s} {'fwd us':>7s}  by kind")
+    for name, f, a in pieces():
+        if name == "full with the model" and not args.reverse:
+            continue
+        forward_us = loop_time(f, *a, repeats=args.repeats) * 1e6 if args.reverse else None
+        g = reverse(f) if args.reverse else f
+        text = compiled_text(g, *a)
+        ops = entry_ops(text)
+        us = loop_time(g, *a, repeats=args.repeats) * 1e6
+        kinds = {k: v for k, v in ops.most_common() if k != "parameter"}
+        rows.append({"piece": name, "ops": sum(kinds.values()), "us": us, "forward_us": forward_us, "by_kind": kinds})
+        shown = f"{forward_us:7.1f}" if forward_us is not None else f"{'':7s}"
+        print(f"{name:28s} {sum(kinds.values()):5d} {us:8.1f} {shown}  {dict(list(kinds.items())[:6])}", flush=True)
+        if name == by_source_of and args.by_source:
+            sources = ops_by_source(text)
+    return rows, sources
 
 
 def main():
@@ -174,20 +219,14 @@ def main():
     parser.add_argument("--repeats", type=int, default=5, help="timed loops per piece (best taken)")
     parser.add_argument("--by-source", type=int, default=0, metavar="N",
                         help="also list the N jaxveh functions with the most operations in the full evaluation")
+    parser.add_argument("--reverse", action="store_true",
+                        help="profile each piece's vector-Jacobian product (beside its forward time)")
     args = parser.parse_args()
-    rows, sources = [], None
-    print(f"{'piece':28s} {'ops':>5s} {'us':>8s}  by kind")
-    for name, f, a in pieces():
-        text = compiled_text(f, *a)
-        ops = entry_ops(text)
-        us = loop_time(f, *a, repeats=args.repeats) * 1e6
-        kinds = {k: v for k, v in ops.most_common() if k != "parameter"}
-        rows.append({"piece": name, "ops": sum(kinds.values()), "us": us, "by_kind": kinds})
-        print(f"{name:28s} {sum(kinds.values()):5d} {us:8.1f}  {dict(list(kinds.items())[:6])}", flush=True)
-        if name == "full" and args.by_source:
-            sources = ops_by_source(text)
+    with run_time_checks_off():  # as simulate traces the car (and the loop's nudges may not pass them)
+        rows, sources = profile(args)
     if sources is not None:
-        print(f"\nfull evaluation, operations by source ({sum(sources.values())} in all)")
+        what = "vector-Jacobian product (state and model)" if args.reverse else "evaluation"
+        print(f"\nfull {what}, operations by source ({sum(sources.values())} in all)")
         for source, n in sources.most_common(args.by_source):
             print(f"{n:5d}  {source}")
     if args.json:
