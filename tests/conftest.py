@@ -49,51 +49,50 @@ jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 _MAPS, _MAX_MAPS = Path("/proc/self/maps"), Path("/proc/sys/vm/max_map_count")
 
 #: Seconds each module took on a cold cache (both workers busy, 2-core machine; the modules
-#: under a minute are left out). Modules run heaviest first, so that with ``-n 2 --dist
-#: loadfile --no-loadscope-reorder`` the last module to start is a short one (longest
-#: processing time first); within a module the order is the file's. Re-measure with
-#: ``--durations=0`` (or ``JAXVEH_COMPILE_LOG``) when a module's cost changes a lot.
+#: under 50 s are left out), measured on 2026-12-07 by ``--durations=0`` in a whole cold run
+#: without a deadline (61 minutes, 122 worker-minutes). Modules run heaviest first, so that
+#: with ``-n 2 --dist loadfile --no-loadscope-reorder`` the last module to start is a short
+#: one (longest processing time first); within a module the order is the file's. Re-measure
+#: with ``--durations=0`` (or ``JAXVEH_COMPILE_LOG``) when a module's cost changes a lot.
 MODULE_SECONDS = {
-    "test_manoeuvre_fourpost.py": 2117,
-    "test_optimise_step_steer.py": 1730,
-    "test_manoeuvre.py": 1800,
-    "test_vehicle_car.py": 1398,
-    "test_optimise_car.py": 801,
-    "test_optimise_braking.py": 450,
-    "test_analysis_load_transfer.py": 693,
-    "test_vehicle_rigs.py": 534,
-    "test_manoeuvre_steady.py": 477,
-    "test_vehicle_fast.py": 472,
-    "test_optimise_frame.py": 500,
-    "test_manoeuvre_driver.py": 364,
-    "test_multibody_engine.py": 346,
-    "test_optimise_sweep.py": 312,
-    "test_optimise_stiffness.py": 300,
-    "test_analysis_kinematics.py": 299,
-    "test_multibody_flexible.py": 281,
-    "test_multibody_imex.py": 262,
-    "test_manoeuvre_straight_line.py": 240,
-    "test_manoeuvre_brake_in_turn.py": 150,
-    "test_manoeuvre_frequency.py": 221,
-    "test_vehicle_corner.py": 125,
-    "test_optimise_kinematics.py": 200,
-    "test_manoeuvre_ramp.py": 120,
-    "test_multibody_pendulum.py": 111,
-    "test_fe_grad.py": 105,
-    "test_analytic_dynamics.py": 103,
-    "test_plots_layout.py": 99,
-    "test_multibody_simplifications.py": 81,
-    "test_tyre_magic_formula.py": 70,
-    "test_optimise_response.py": 76,
-    "test_analytic_linear.py": 63,
-    "test_vehicle_suspension.py": 60,
+    "test_vehicle_car.py": 666,
+    "test_manoeuvre_fourpost.py": 563,
+    "test_optimise_braking.py": 539,
+    "test_manoeuvre.py": 477,
+    "test_optimise_sweep.py": 389,
+    "test_optimise_car.py": 353,
+    "test_optimise_step_steer.py": 348,
+    "test_vehicle_rigs.py": 331,
+    "test_multibody_engine.py": 250,
+    "test_optimise_frame.py": 247,
+    "test_manoeuvre_steady.py": 237,
+    "test_analysis_load_transfer.py": 203,
+    "test_manoeuvre_straight_line.py": 200,
+    "test_manoeuvre_driver.py": 185,
+    "test_multibody_flexible.py": 184,
+    "test_vehicle_fast.py": 182,
+    "test_multibody_imex.py": 162,
+    "test_manoeuvre_imex.py": 148,
+    "test_optimise_stiffness.py": 142,
+    "test_analysis_kinematics.py": 128,
+    "test_manoeuvre_frequency.py": 103,
+    "test_vehicle_corner.py": 99,
+    "test_analytic_dynamics.py": 77,
+    "test_suite_deadline.py": 75,
+    "test_manoeuvre_replay.py": 67,
+    "test_multibody_simplifications.py": 66,
+    "test_fe_grad.py": 64,
+    "test_plots_layout.py": 58,
+    "test_optimise_kinematics.py": 55,
+    "test_manoeuvre_brake_in_turn.py": 54,
+    "test_multibody_pendulum.py": 52,
 }
 
 
 #: Unix time after which long tests are skipped (``$JAXVEH_TEST_DEADLINE``; unset: none).
 #: CI sets it so that the suite ends within CI's limit on a cold compilation cache. Long
 #: tests are those marked ``slow`` and those of the heavy modules (``MODULE_SECONDS`` of
-#: 200 s or more: the modules that compile the car). Past the deadline none starts, and one
+#: 200 s or more: the heaviest of the modules that compile the car). Past the deadline none starts, and one
 #: still running ``ABANDON_AFTER`` seconds past it (``$JAXVEH_TEST_ABANDON_AFTER``; 900) is
 #: abandoned, reported as skipped, the next time Python runs: a single test can take half an
 #: hour on a cold cache, so the deadline alone does not bound the suite (a CI run was
