@@ -139,8 +139,9 @@ def loop_time(f, *args, repeats: int) -> float:
     return best
 
 
-def pieces():
-    """``(name, function, arguments)`` of every piece at one state of the library car."""
+def pieces(with_model: bool = False):
+    """``(name, function, arguments)`` of every piece at one state of the library car;
+    ``with_model``: also the full evaluation as a function of the fast model."""
     car = load_car(modes=6)
     elements = car_elements(car, ConstantSpeed(25.0))
     inputs = steering(car, lambda t: 0.05 * jnp.sin(3.0 * t) + 0.02)
@@ -171,8 +172,9 @@ def pieces():
     yield "four-corner suspension", lambda kin: fs.suspension_forces(four, kin), (kin,)
     yield "full", lambda q, u, aux: _outputs(fast.fast_dynamics(car, model, q, u, aux, 0.3, inputs, elements)), (
         q, u, aux)
-    yield "full with the model", lambda q, u, aux, model: _outputs(
-        fast.fast_dynamics(car, model, q, u, aux, 0.3, inputs, elements)), (q, u, aux, model)
+    if with_model:
+        yield "full with the model", lambda q, u, aux, model: _outputs(
+            fast.fast_dynamics(car, model, q, u, aux, 0.3, inputs, elements)), (q, u, aux, model)
 
 
 def _outputs(d):
@@ -196,9 +198,7 @@ def profile(args):
     rows, sources = [], None
     by_source_of = "full with the model" if args.reverse else "full"
     print(f"{'piece':28s} {'ops':>5s} {'us':>8s} {'fwd us':>7s}  by kind")
-    for name, f, a in pieces():
-        if name == "full with the model" and not args.reverse:
-            continue
+    for name, f, a in pieces(with_model=args.reverse):
         forward_us = loop_time(f, *a, repeats=args.repeats) * 1e6 if args.reverse else None
         g = reverse(f) if args.reverse else f
         text = compiled_text(g, *a)

@@ -92,8 +92,8 @@ MODULE_SECONDS = {
 #: Unix time after which long tests are skipped (``$JAXVEH_TEST_DEADLINE``; unset: none).
 #: CI sets it so that the suite ends within CI's limit on a cold compilation cache. Long
 #: tests are those marked ``slow`` and those of the heavy modules (``MODULE_SECONDS`` of
-#: 200 s or more: the heaviest of the modules that compile the car). Past the deadline none starts, and one
-#: still running ``ABANDON_AFTER`` seconds past it (``$JAXVEH_TEST_ABANDON_AFTER``; 900) is
+#: 200 s or more: the heaviest of the modules that compile the car). Past the deadline none
+#: starts, and one still running ``ABANDON_AFTER`` seconds past it (``$JAXVEH_TEST_ABANDON_AFTER``; 900) is
 #: abandoned, reported as skipped, the next time Python runs: a single test can take half an
 #: hour on a cold cache, so the deadline alone does not bound the suite (a CI run was
 #: stopped at 90 minutes with one worker inside a test it had started before the deadline).
@@ -254,13 +254,16 @@ _COMPILE_LOG = os.environ.get("JAXVEH_COMPILE_LOG")
 
 if _COMPILE_LOG:
 
+    def _append_to_log(*fields: str):
+        """Append the current test and ``fields`` as one tab-separated line to ``$JAXVEH_COMPILE_LOG``."""
+        with open(_COMPILE_LOG, "a") as f:
+            f.write("\t".join((_current_test[0], *fields)) + "\n")
+
     def _log_compile_phase(event: str, duration: float, **kwargs):
         """Append ``test, phase, seconds, function`` for each tracing, lowering, XLA
         compilation and disk-cache retrieval (tab-separated) to ``$JAXVEH_COMPILE_LOG``."""
         if event.endswith("_duration") or "compilation_cache" in event:
-            with open(_COMPILE_LOG, "a") as f:
-                f.write(f"{_current_test[0]}\t{event.rsplit('/', 1)[-1]}\t{duration:.3f}"
-                        f"\t{kwargs.get('fun_name', '')}\n")
+            _append_to_log(event.rsplit("/", 1)[-1], f"{duration:.3f}", kwargs.get("fun_name", ""))
 
     class _CacheLookups(logging.Handler):
         """Append ``test, cache_hit|cache_miss, 0, program, key`` for each lookup in the
@@ -272,8 +275,7 @@ if _COMPILE_LOG:
                        else "cache_hit" if message.startswith("Persistent compilation cache hit") else None)
             if outcome is not None:
                 program, key = record.args
-                with open(_COMPILE_LOG, "a") as f:
-                    f.write(f"{_current_test[0]}\t{outcome}\t0\t{program}\t{key}\n")
+                _append_to_log(outcome, "0", program, key)
 
     monitoring.register_event_duration_secs_listener(_log_compile_phase)
     _compiler_logger = logging.getLogger("jax._src.compiler")
