@@ -7,6 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._core import GRAVITY
+from .._trig import arcsin, arctan2
 from ..vehicle import CORNERS, Car, Powertrain, PushrodSuspension, TyreContact, chassis_twist, wheel_centres
 
 #: Channel name -> unit (per corner channels hold FL, FR, RL, RR on their last axis).
@@ -98,13 +99,13 @@ def car_channels(car: Car, elements: tuple, kin, aux, chassis_velocity, chassis_
         "speed": jnp.hypot(v_cg[0], v_cg[1]),
         "x": cg_global[0],
         "y": cg_global[1],
-        "heading": jnp.arctan2(a_c[1, 0], a_c[0, 0]) * deg,
+        "heading": arctan2(a_c[1, 0], a_c[0, 0]) * deg,
         "ax": a_cg[0] / GRAVITY,
         "ay": a_cg[1] / GRAVITY,
         "yaw_rate": w[2] * deg,
-        "sideslip": jnp.arctan2(v_cg[1], v_cg[0]) * deg,
-        "roll": jnp.arctan2(a_c[2, 1], a_c[2, 2]) * deg,
-        "pitch": -jnp.arcsin(a_c[2, 0]) * deg,
+        "sideslip": arctan2(v_cg[1], v_cg[0]) * deg,
+        "roll": arctan2(a_c[2, 1], a_c[2, 2]) * deg,
+        "pitch": -arcsin(a_c[2, 0]) * deg,
         "twist": chassis_twist(car, modes) * deg,
         "modes": modes,
         "fz": tyre["fz"],
@@ -115,7 +116,7 @@ def car_channels(car: Car, elements: tuple, kin, aux, chassis_velocity, chassis_
         "camber": tyre["gamma"] * deg,
         "road_height": tyre["road_height"],
         "travel": centre[:, 2] - wheel_centres(car.params.vehicle)[:, 2],
-        "road_wheel_angle": jnp.arctan2(-rel[:, 0, 1], rel[:, 1, 1]) * deg,
+        "road_wheel_angle": arctan2(-rel[:, 0, 1], rel[:, 1, 1]) * deg,
         "spring_length": jnp.concatenate(lengths),
         "spring_force": jnp.concatenate(forces),
         "wheel_torque": _wheel_torques(car, elements, kin, aux),

@@ -17,6 +17,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from .._core import GRAVITY, ParameterError, is_concrete
+from .._trig import sin
 from ..params import Range, checked_field
 from ..vehicle import AbstractRoad, AbstractSpeedTarget, FlatRoad, SpeedChange
 
@@ -88,7 +89,7 @@ class SweptSine(AbstractSteeringLaw):
     start: Float[Array, ""] = checked_field("SweptSine.start", _TIME)
 
     def __call__(self, t):
-        return self.amplitude * jnp.sin(sweep_phase(t, self.f0, self.f1, self.sweep, self.start))
+        return self.amplitude * sin(sweep_phase(t, self.f0, self.f1, self.sweep, self.start))
 
     def kinks(self):
         return (self.start, self.start + self.sweep)

@@ -20,6 +20,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from .._core import ParameterError, is_concrete
+from .._trig import arctan2, cos, sin
 from ..params import Range, checked_field
 
 #: ISO 3888-1 sections: (length m, lane-width factor on the car's width, lane-width
@@ -58,8 +59,8 @@ class Circle(AbstractPath):
     def target(self, position, heading, distance):
         del heading
         rel = position - self._centre()
-        angle = jnp.arctan2(rel[1], rel[0]) + self.turn * distance / self.radius
-        return self._centre() + self.radius * jnp.stack([jnp.cos(angle), jnp.sin(angle)])
+        angle = arctan2(rel[1], rel[0]) + self.turn * distance / self.radius
+        return self._centre() + self.radius * jnp.stack([cos(angle), sin(angle)])
 
     def lateral_error(self, position):
         # left of a left turn is inside the circle

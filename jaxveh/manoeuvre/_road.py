@@ -14,6 +14,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .._core import ParameterError
+from .._trig import sin
 from ..params import Range, checked_field
 from ..vehicle import AbstractRoad
 from ._driver import Manoeuvre, Straight, sweep_phase
@@ -44,7 +45,7 @@ class PostSweep(AbstractRoad):
 
     def displacement(self, t) -> Float[Array, ""]:
         """The post motion of a corner with phase +1 (m) at time ``t`` (s)."""
-        return self.amplitude * jnp.sin(sweep_phase(t, self.f0, self.f1, self.sweep, self.start))
+        return self.amplitude * sin(sweep_phase(t, self.f0, self.f1, self.sweep, self.start))
 
     def height(self, x, y, t, wheel):
         return self.phases[wheel] * self.displacement(t) + jnp.zeros_like(x + y)

@@ -23,6 +23,7 @@ from jaxtyping import Array, Float
 
 from .. import multibody as mb
 from .._core import ParameterError, is_concrete, run_time_checks_off
+from .._trig import arctan2
 from ..multibody._simulate import _hold_after_stop
 from ..vehicle import (
     ConstantSpeed,
@@ -254,7 +255,7 @@ def _rolled_over(q, u):
 
 def _spun(q, u):
     """The chassis velocity (body axes ``u[:2]``) beyond :data:`SPIN_ANGLE` from its x axis."""
-    return jnp.abs(jnp.arctan2(u[1], u[0])) > SPIN_ANGLE
+    return jnp.abs(arctan2(u[1], u[0])) > SPIN_ANGLE
 
 
 def _event_code(rolled, spun):

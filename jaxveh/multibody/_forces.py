@@ -19,6 +19,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .._core import float_field
+from .._trig import arctan2
 from ._kinematics import _add_modal, _body_rows, _frames, points_global, points_local
 from ._system import System, SystemParams
 
@@ -164,7 +165,7 @@ class TorsionSpring(AbstractForceElement):
         e = jnp.cross(n, jnp.eye(3, dtype=n.dtype)[jnp.argmin(jnp.abs(n))])
         e = e / jnp.linalg.norm(e)
         re = rel @ e
-        phi = jnp.arctan2(jnp.dot(jnp.cross(e, re), n), jnp.dot(e, re))
+        phi = arctan2(jnp.dot(jnp.cross(e, re), n), jnp.dot(e, re))
         phi_dot = n @ (a.T @ (kin.point_omega[self.j] - kin.point_omega[self.i]))
         torque = a @ (n * (self.kt * (phi - self.phi0) + self.ct * phi_dot))
         out = zero_forces(kin)

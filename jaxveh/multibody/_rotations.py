@@ -10,6 +10,8 @@ the reverse of the thesis's ``[phi, theta, psi]`` listing of eq. (5.1).
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
+from .._trig import cos, sin, sin_cos
+
 SEQUENCES = ("zyx", "zxy", "xyz", "xzy", "yxz", "yzx")
 _AXIS = {"x": 0, "y": 1, "z": 2}
 
@@ -24,7 +26,7 @@ def skew(a: Float[Array, "3"]) -> Float[Array, "3 3"]:
 
 def elementary(axis: int, angle: Float[Array, ""]) -> Float[Array, "3 3"]:
     """Rotation by ``angle`` (rad) about coordinate axis ``axis`` (0 = x, 1 = y, 2 = z)."""
-    c, s = jnp.cos(angle), jnp.sin(angle)
+    s, c = sin_cos(angle)
     o, z = jnp.ones_like(c), jnp.zeros_like(c)
     if axis == 0:
         rows = [[o, z, z], [z, c, -s], [z, s, c]]
@@ -55,4 +57,4 @@ def angular_velocity_matrix(sequence: str, angles: Float[Array, "3"]) -> Float[A
 def axis_angle(axis: Float[Array, "3"], angle: Float[Array, ""]) -> Float[Array, "3 3"]:
     """Rodrigues rotation by ``angle`` (rad) about the unit vector ``axis``."""
     k = skew(axis)
-    return jnp.eye(3, dtype=axis.dtype) + jnp.sin(angle) * k + (1.0 - jnp.cos(angle)) * (k @ k)
+    return jnp.eye(3, dtype=axis.dtype) + sin(angle) * k + (1.0 - cos(angle)) * (k @ k)

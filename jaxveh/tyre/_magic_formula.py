@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
+from .._trig import cos, sin, tan
 from ._base import TyreForces
 
 if TYPE_CHECKING:
@@ -64,13 +65,13 @@ def _safe_div(num, den):
 def _mf(b, c, d, e, x):
     """The Magic Formula sine form ``D sin(C atan(Bx - E(Bx - atan Bx)))``."""
     bx = b * x
-    return d * jnp.sin(c * jnp.arctan(bx - e * (bx - jnp.arctan(bx))))
+    return d * sin(c * jnp.arctan(bx - e * (bx - jnp.arctan(bx))))
 
 
 def _mf_cos(b, c, e, x):
     """The cosine weighting ``cos(C atan(Bx - E(Bx - atan Bx)))`` (value 1 at x = 0)."""
     bx = b * x
-    return jnp.cos(c * jnp.arctan(bx - e * (bx - jnp.arctan(bx))))
+    return cos(c * jnp.arctan(bx - e * (bx - jnp.arctan(bx))))
 
 
 def _weight(b, c, e, x, shift):
@@ -104,7 +105,7 @@ def _lateral(t: "MagicFormulaTyre", fz, fz0, dfz, alpha, gamma):
     dy = muy * fz
     ey = (t.pey1 + t.pey2 * dfz) * (1.0 - (t.pey3 + t.pey4 * gy) * jnp.sign(ay)) * t.ley
     ey = jnp.minimum(ey, 1.0)
-    ky = t.pky1 * fz0 * jnp.sin(2.0 * jnp.arctan(fz / (t.pky2 * fz0))) * (1.0 - t.pky3 * jnp.abs(gy)) * t.lky
+    ky = t.pky1 * fz0 * sin(2.0 * jnp.arctan(fz / (t.pky2 * fz0))) * (1.0 - t.pky3 * jnp.abs(gy)) * t.lky
     by = _safe_div(ky, cy * dy)
     svy = fz * ((t.pvy1 + t.pvy2 * dfz) * t.lvy + (t.pvy3 + t.pvy4 * dfz) * gy) * t.lmuy
     fy0 = _mf(by, cy, dy, ey, ay) + svy
@@ -162,15 +163,15 @@ def tyre_forces(
     fy0, muy, ky, by, cy, shy, svy = _lateral(t, fz, fz0, dfz, alpha, gamma)
 
     # combined Fx
-    bxa = t.rbx1 * jnp.cos(jnp.arctan(t.rbx2 * kappa)) * t.lxal
+    bxa = t.rbx1 * cos(jnp.arctan(t.rbx2 * kappa)) * t.lxal
     gxa = _weight(bxa, t.rcx1, jnp.minimum(t.rex1 + t.rex2 * dfz, 1.0), alpha, t.rhx1)
     fx = gxa * fx0
 
     # combined Fy with kappa-induced side force
-    byk = t.rby1 * jnp.cos(jnp.arctan(t.rby2 * (alpha - t.rby3))) * t.lyka
+    byk = t.rby1 * cos(jnp.arctan(t.rby2 * (alpha - t.rby3))) * t.lyka
     gyk = _weight(byk, t.rcy1, jnp.minimum(t.rey1 + t.rey2 * dfz, 1.0), kappa, t.rhy1 + t.rhy2 * dfz)
-    dvyk = muy * fz * (t.rvy1 + t.rvy2 * dfz + t.rvy3 * gamma) * jnp.cos(jnp.arctan(t.rvy4 * alpha))
-    svyk = dvyk * jnp.sin(t.rvy5 * jnp.arctan(t.rvy6 * kappa)) * t.lvyka
+    dvyk = muy * fz * (t.rvy1 + t.rvy2 * dfz + t.rvy3 * gamma) * cos(jnp.arctan(t.rvy4 * alpha))
+    svyk = dvyk * sin(t.rvy5 * jnp.arctan(t.rvy6 * kappa)) * t.lvyka
     fy = gyk * fy0 + svyk
 
     # aligning moment: pneumatic trail and residual torque at equivalent slip angles
@@ -188,11 +189,11 @@ def tyre_forces(
     br = t.qbz9 * t.lky / t.lmuy + t.qbz10 * by * cy
     dr = fz * ((t.qdz6 + t.qdz7 * dfz) * t.lres + (t.qdz8 + t.qdz9 * dfz) * gz) * r0 * t.lmuy
     kratio2 = _safe_div(kxk, ky) ** 2 * kappa**2
-    at_eq = jnp.arctan(_safe_sqrt(jnp.tan(at) ** 2 + kratio2))  # sign dropped: even functions
-    ar_eq = jnp.arctan(_safe_sqrt(jnp.tan(ar) ** 2 + kratio2))
-    cos_a = jnp.cos(alpha)
+    at_eq = jnp.arctan(_safe_sqrt(tan(at) ** 2 + kratio2))  # sign dropped: even functions
+    ar_eq = jnp.arctan(_safe_sqrt(tan(ar) ** 2 + kratio2))
+    cos_a = cos(alpha)
     trail = dt * _mf_cos(bt, ct, et, at_eq) * cos_a
-    mzr = dr * jnp.cos(jnp.arctan(br * ar_eq)) * cos_a
+    mzr = dr * cos(jnp.arctan(br * ar_eq)) * cos_a
     s = r0 * (t.ssz1 + t.ssz2 * (fy / fz0) + (t.ssz3 + t.ssz4 * dfz) * gamma) * t.ls
     mz = -trail * (fy - svyk) + mzr + s * fx
 

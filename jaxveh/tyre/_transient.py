@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
+from .._trig import sin
 from ..params import Range, check
 from ._magic_formula import LIFTOFF_FRACTION
 
@@ -48,7 +49,7 @@ def relaxation_lengths(tyre: "MagicFormulaTyre", fz: ArrayLike, gamma: ArrayLike
     dfz = (fz - fz0) / fz0
     r0 = t.unloaded_radius
     sk = fz * (t.ptx1 + t.ptx2 * dfz) * jnp.exp(-t.ptx3 * dfz) * (r0 / fz0) * t.lsgkp
-    sa = t.pty1 * jnp.sin(2.0 * jnp.arctan(fz / (t.pty2 * fz0))) * (1.0 - t.pky3 * jnp.abs(gamma * t.lgay))
+    sa = t.pty1 * sin(2.0 * jnp.arctan(fz / (t.pty2 * fz0))) * (1.0 - t.pky3 * jnp.abs(gamma * t.lgay))
     sa = sa * r0 * t.lfzo * t.lsgal
     return check("sigma_kappa", sk, _LENGTH_KAPPA), check("sigma_alpha", sa, _LENGTH_ALPHA)
 

@@ -34,6 +34,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._trig import arcsin
 from ..multibody import AbstractForceElement, ElementForces, zero_forces
 from ..tyre import (
     effective_rolling_radius,
@@ -98,7 +99,7 @@ def contact_geometry(centre, axis, road_height=0.0, road_slope=(0.0, 0.0)):
     height = (centre[2] - road_height) * normal[2]  # above the road plane, along its normal
     h = height / cos_gamma
     contact = centre - h * radial / cos_gamma
-    return e_x, e_y, jnp.arcsin(jnp.clip(sin_gamma, -1.0, 1.0)), h, contact, normal
+    return e_x, e_y, arcsin(jnp.clip(sin_gamma, -1.0, 1.0)), h, contact, normal
 
 
 def wheel_contact(tyre, centre, centre_velocity, axis, omega_wheel, omega_upright, deflection,

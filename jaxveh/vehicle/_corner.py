@@ -8,6 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._core import GRAVITY, float_field, is_concrete
+from .._trig import arctan2
 from ..multibody import (
     AssemblyError,
     System,
@@ -141,7 +142,7 @@ def wheel_angles(system: System, params: SystemParams, q):
     camber = atan2(-a_z, a_y) (positive top outwards), toe-in = atan2(a_x, a_y)."""
 
     a = body_poses(system, params, q)[system.body_names.index("upright")][1][:, 1]
-    return jnp.arctan2(-a[2], a[1]), jnp.arctan2(a[0], a[1])
+    return arctan2(-a[2], a[1]), arctan2(a[0], a[1])
 
 
 def quarter_car_kinematics(

@@ -25,6 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
+from .._trig import arccos, cos, sin_cos
 from ..multibody import System, SystemParams
 from ._car import CORNERS
 from ._corner import QUARTER_CAR_LINKS
@@ -103,7 +104,7 @@ def _rotation_zxy(angles, derivatives: bool = False) -> list:
     derivatives with respect to the three angles: ``[A, dA/d0, dA/d1, dA/d2]``."""
     factors, slopes = [], []
     for axis, angle in zip((2, 0, 1), angles, strict=True):
-        c, s = jnp.cos(angle), jnp.sin(angle)
+        s, c = sin_cos(angle)
         o, z = jnp.ones_like(c), jnp.zeros_like(c)
         factors.append(_elementary(axis, c, s, o, z))
         slopes.append(_elementary(axis, -s, c, z, z))
@@ -167,7 +168,7 @@ def _rotate_jet(axis: int, angle, rate, jet):
     ``R' u`` turns the rotated vector a quarter turn in the plane of the rotation and
     ``R'' u`` is minus its part in that plane."""
     i, j = _PLANE[axis]
-    c, s = jnp.cos(angle), jnp.sin(angle)
+    s, c = sin_cos(angle)
 
     def turn(v):
         out = list(v)
@@ -313,8 +314,8 @@ def _chebyshev(x, degree):
     """``[T_0(x), ..., T_degree(x)]`` as ``cos(k arccos x)`` (one fused loop; the
     three-term recurrence is a chain of separate operations). No derivative with respect to
     ``x``: the guess only starts the solve, whose derivatives do not depend on it."""
-    angle = jnp.arccos(jax.lax.stop_gradient(x))
-    return jnp.cos(jnp.arange(degree + 1.0)[:, None] * angle[None, :])
+    angle = arccos(jax.lax.stop_gradient(x))
+    return cos(jnp.arange(degree + 1.0)[:, None] * angle[None, :])
 
 
 def _scaled(v, lo, hi):

@@ -30,6 +30,7 @@ import numpy as np
 from jax.scipy.linalg import cho_factor, cho_solve
 from jaxtyping import Array, Float
 
+from .._trig import sin_cos
 from ..multibody import Kinematics, SystemParams, body_forces, element_forces, input_state, rotation_matrix
 from ..multibody._inputs import as_inputs
 from ..multibody._rotations import elementary, skew
@@ -414,9 +415,11 @@ def coordinate_rates(car: Car, q, u):
     r_dot = rotation_matrix("zyx", angles) @ u[:3]
     pitch, roll = angles[1], angles[2]
     wx, wy, wz = u[3], u[4], u[5]
-    lateral = wy * jnp.sin(roll) + wz * jnp.cos(roll)
-    angle_rates = jnp.stack([lateral / jnp.cos(pitch), wy * jnp.cos(roll) - wz * jnp.sin(roll),
-                             wx + lateral * jnp.tan(pitch)])
+    sin_roll, cos_roll = sin_cos(roll)
+    sin_pitch, cos_pitch = sin_cos(pitch)
+    lateral = wy * sin_roll + wz * cos_roll
+    angle_rates = jnp.stack([lateral / cos_pitch, wy * cos_roll - wz * sin_roll,
+                             wx + lateral * sin_pitch / cos_pitch])
     return jnp.concatenate([r_dot, angle_rates, u[6:]])
 
 

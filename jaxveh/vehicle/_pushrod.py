@@ -26,6 +26,8 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
+from .._trig import sin_cos
+
 Vec = Float[Array, "3"]
 
 
@@ -89,7 +91,8 @@ def rotate_about_axis(x: Vec, xp: Vec, xq: Vec, angle) -> Vec:
     """``x`` turned by ``angle`` (rad, right-handed about P->Q) about the axis through P, Q."""
     u = _unit(xq - xp)
     r = x - xp
-    return xp + r * jnp.cos(angle) + jnp.cross(u, r) * jnp.sin(angle) + u * jnp.dot(u, r) * (1.0 - jnp.cos(angle))
+    s, c = sin_cos(angle)
+    return xp + r * c + jnp.cross(u, r) * s + u * jnp.dot(u, r) * (1.0 - c)
 
 
 class RockerGeometry(eqx.Module):
