@@ -12,8 +12,9 @@ polynomials and selects, which XLA fuses with their neighbours and vectorises:
   for |x| < 2^26 pi / 2, about 1e8 rad), then the Taylor series of sin and cos on
   |r| <= pi / 4 to the 17th and 16th power (truncation below 1e-18 relative).
 - ``arctan``, ``arctan2``, ``arcsin``, ``arccos``: the argument reduced to [0, 1] by the
-  reciprocal, halved twice by ``atan t = 2 atan(t / (1 + sqrt(1 + t^2)))`` to at most
-  tan(pi / 16), then the arctangent's series to the 23rd power.
+  reciprocal, then taken about the nearest of the centres ``c = k / 8``,
+  ``atan t = atan c + atan((t - c) / (1 + t c))``, whose remainder (at most 1 / 16) goes
+  by the arctangent's series to the 15th power.
 
 Each agrees with NumPy's to a few units in the last place (tests/test_trig.py) and
 keeps the symmetries exactly (odd functions odd, even ones even). The derivatives are the

@@ -28,7 +28,10 @@ Numerical treatment (all documented in ``docs/tyre.md``):
 - speed only enters the rolling resistance moment, whose sign follows
   ``tanh(vx / VXLOW)`` so it vanishes smoothly at standstill;
 - the equivalent slip angles of combined Mz enter only even functions, so their sign is
-  dropped and the square root uses a safe double-``where`` at zero slip.
+  dropped and the square root uses a safe double-``where`` at zero slip;
+- sines, cosines and tangents are :mod:`jaxveh._trig`'s fused arithmetic; the arctangents
+  stay ``jnp``'s, whose fused form split the nested formulas into twice the kernels
+  (docs/manoeuvre.md, "Speed", thirtieth measurement).
 """
 
 from typing import TYPE_CHECKING
