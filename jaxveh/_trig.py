@@ -22,38 +22,38 @@ closed forms by ``jax.custom_jvp`` (for ``sin``, ``cos`` the other of the pair, 
 call computes together), so forward and reverse mode cost what ``jnp``'s do.
 """
 
-from decimal import Decimal, getcontext
+from decimal import Decimal, localcontext
 from math import factorial
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-# pi to 60 digits, as a decimal: the reduction's constants are exact splits of it
-getcontext().prec = 80
-_PI = Decimal("3.14159265358979323846264338327950288419716939937510582097494459")
+#: pi to 63 digits (the reduction's constants are exact splits of it)
+_PI = "3.14159265358979323846264338327950288419716939937510582097494459"
 
 
-def _split(value: Decimal, parts: int, bits: int) -> tuple[float, ...]:
-    """``value`` as ``parts`` doubles whose sum approximates it to about ``parts * bits``
-    bits, all but the last with at most ``bits`` significant bits (their products with
-    integers below 2^(53 - bits) are exact)."""
+def _half_pi_parts(parts: int, bits: int) -> tuple[float, ...]:
+    """pi / 2 as ``parts`` doubles whose sum approximates it to about ``parts * bits`` bits,
+    all but the last with at most ``bits`` significant bits (their products with integers
+    below 2^(53 - bits) are exact)."""
     out = []
-    rest = value
-    for k in range(parts):
-        x = float(rest)
-        if k < parts - 1:
-            mantissa, exponent = np.frexp(x)
-            x = float(np.ldexp(np.floor(mantissa * 2.0**bits), int(exponent) - bits))
-        out.append(x)
-        rest -= Decimal(x)
+    with localcontext() as context:
+        context.prec = 80
+        rest = Decimal(_PI) / 2
+        for k in range(parts):
+            x = float(rest)
+            if k < parts - 1:
+                mantissa, exponent = np.frexp(x)
+                x = float(np.ldexp(np.floor(mantissa * 2.0**bits), int(exponent) - bits))
+            out.append(x)
+            rest -= Decimal(x)
     return tuple(out)
 
 
-_PIO2_PARTS = _split(_PI / 2, 3, 27)
-_TWO_OVER_PI = float(2 / _PI)
-_PIO2 = float(_PI / 2)
-_PIO4 = float(_PI / 4)
+_PIO2_PARTS = _half_pi_parts(3, 27)
+_PIO2 = float(np.pi / 2)
+_TWO_OVER_PI = float(2 / np.pi)
 #: sin r = r (1 - r^2 / 3! + r^4 / 5! - ...) and cos r = 1 - r^2 / 2! + ... as polynomials in r^2
 _SIN = tuple((-1.0) ** k / factorial(2 * k + 1) for k in range(9))
 _COS = tuple((-1.0) ** k / factorial(2 * k) for k in range(9))
