@@ -20,7 +20,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from .._core import ParameterError, is_concrete
-from .._trig import arctan2, cos, sin
+from .._trig import arctan2, sin_cos
 from ..params import Range, checked_field
 
 #: ISO 3888-1 sections: (length m, lane-width factor on the car's width, lane-width
@@ -60,7 +60,8 @@ class Circle(AbstractPath):
         del heading
         rel = position - self._centre()
         angle = arctan2(rel[1], rel[0]) + self.turn * distance / self.radius
-        return self._centre() + self.radius * jnp.stack([cos(angle), sin(angle)])
+        s, c = sin_cos(angle)
+        return self._centre() + self.radius * jnp.stack([c, s])
 
     def lateral_error(self, position):
         # left of a left turn is inside the circle

@@ -27,7 +27,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._trig import cos, sin
+from .._trig import sin_cos
 from ..multibody import AbstractForceElement, StateInputs, zero_forces
 from ..params import Range, checked_field
 from ..vehicle import steering_rack, system_params, wheel_centres
@@ -54,7 +54,7 @@ class PurePursuit(eqx.Module):
         """Steering-wheel angle (rad) the driver aims for at ``position`` (m), ``heading``
         (rad)."""
         rel = self.path.target(position, heading, self.preview) - position
-        c, s = cos(heading), sin(heading)
+        s, c = sin_cos(heading)
         ahead, left = c * rel[0] + s * rel[1], c * rel[1] - s * rel[0]
         return self.gain * 2.0 * left / (ahead * ahead + left * left)
 

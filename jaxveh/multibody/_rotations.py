@@ -10,7 +10,7 @@ the reverse of the thesis's ``[phi, theta, psi]`` listing of eq. (5.1).
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from .._trig import cos, sin, sin_cos
+from .._trig import sin_cos
 
 SEQUENCES = ("zyx", "zxy", "xyz", "xzy", "yxz", "yzx")
 _AXIS = {"x": 0, "y": 1, "z": 2}
@@ -57,4 +57,5 @@ def angular_velocity_matrix(sequence: str, angles: Float[Array, "3"]) -> Float[A
 def axis_angle(axis: Float[Array, "3"], angle: Float[Array, ""]) -> Float[Array, "3 3"]:
     """Rodrigues rotation by ``angle`` (rad) about the unit vector ``axis``."""
     k = skew(axis)
-    return jnp.eye(3, dtype=axis.dtype) + sin(angle) * k + (1.0 - cos(angle)) * (k @ k)
+    s, c = sin_cos(angle)
+    return jnp.eye(3, dtype=axis.dtype) + s * k + (1.0 - c) * (k @ k)

@@ -18,7 +18,7 @@ only that yaw rotation, and the convention for camber:
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
-from .._trig import cos, sin
+from .._trig import sin_cos
 from ..params import require
 from ._base import TyreForces
 
@@ -45,7 +45,7 @@ def velocity_to_wheel(velocity: Float[Array, "3"], heading: ArrayLike) -> tuple[
         velocity: velocity of the contact point in vehicle axes (x fwd, y left, z up) [m/s].
         heading: wheel heading angle delta relative to vehicle x, positive left [rad].
     """
-    c, s = cos(heading), sin(heading)
+    s, c = sin_cos(heading)
     return c * velocity[0] + s * velocity[1], -s * velocity[0] + c * velocity[1]
 
 
@@ -72,7 +72,7 @@ def forces_to_vehicle(
             ``max(fz, 0)`` upwards.
         heading: wheel heading delta [rad], positive left.
     """
-    c, s = cos(heading), sin(heading)
+    s, c = sin_cos(heading)
     fz_up = jnp.maximum(jnp.asarray(fz, dtype=jnp.float64), 0.0)
     force = jnp.stack([c * forces.fx - s * forces.fy, s * forces.fx + c * forces.fy, fz_up])
     moment = jnp.stack([c * forces.mx - s * forces.my, s * forces.mx + c * forces.my, forces.mz])
